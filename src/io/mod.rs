@@ -1,0 +1,82 @@
+//! Readers and writers of model files. Readers turn bytes into a validated [`TMesh`]
+//! wrapped in a [`Model`]; they never evaluate the surface themselves.
+//!
+//! Formats: the project's JSON T-mesh ([`json`]). The format is detected from the content,
+//! not from a file name, so the page and the CLI accept the same bytes.
+
+pub mod json;
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+
+/// Model file formats the readers know.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    Json,
+    Tsm,
+    Obj,
+}
+
+impl Format {
+    /// Short lower-case name (`json`, `tsm`, `obj`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Json => "json",
+            Format::Tsm => "tsm",
+            Format::Obj => "obj",
+        }
+    }
+}
+
+/// Guesses the format from the first meaningful bytes.
+pub fn detect(bytes: &[u8]) -> Result<Format> {
+    let start = bytes
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .ok_or_else(|| Error::parse("model", "byte 0", "the file is empty"))?;
+    let head = &bytes[start..];
+    if head.starts_with(b"{") {
+        Ok(Format::Json)
+    } else if head.starts_with(b"#TS") {
+        Ok(Format::Tsm)
+    } else if head
+        .split(|&b| b == b'\n')
+        .take(200)
+        .any(|l| l.starts_with(b"v ") || l.starts_with(b"f "))
+    {
+        Ok(Format::Obj)
+    } else {
+        Err(Error::parse(
+            "model",
+            "start of file",
+            "not a model file this program knows (expected JSON T-mesh, .tsm or .obj)",
+        ))
+    }
+}
+
+/// Reads a model from bytes, format detected from the content. `name` is used when the
+/// file carries no name of its own.
+pub fn load(bytes: &[u8], name: &str) -> Result<Model> {
+    match detect(bytes)? {
+        Format::Json => {
+            let text = std::str::from_utf8(bytes).map_err(|e| {
+                Error::parse(
+                    "json",
+                    format!("byte {}", e.valid_up_to()),
+                    "the file is not UTF-8 text",
+                )
+            })?;
+            let (mesh, meta) = json::read(text)?;
+            let name = if meta.name.is_empty() {
+                name
+            } else {
+                &meta.name
+            };
+            Model::try_new(name, "json", &meta.units, mesh)
+        }
+        f => Err(Error::Unsupported(format!(
+            "{} files are not readable by this build yet",
+            f.name()
+        ))),
+    }
+}

@@ -1,0 +1,74 @@
+//! A loaded model: its T-mesh, the surface evaluated from it, and what the reader learnt.
+//!
+//! Owns: the bundle handed from readers to planners and its summary. Must not: parse bytes
+//! (that is `io`) or evaluate (that is `surface`).
+
+pub mod samples;
+
+use crate::error::Result;
+use crate::geom::Aabb;
+use crate::surface::Surface;
+use crate::tmesh::TMesh;
+use serde::{Deserialize, Serialize};
+
+/// A model ready for planning.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub name: String,
+    /// File format it came from (`json`, `obj`, `tsm`, or `sample`).
+    pub format: String,
+    /// Unit the file declared; coordinates are millimetres whatever it was.
+    pub units_read: String,
+    pub mesh: TMesh,
+    pub surface: Surface,
+}
+
+/// Counts and size of a model, as shown by `tspath info` and the page.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelSummary {
+    pub name: String,
+    pub format: String,
+    pub units_read: String,
+    pub vertices: usize,
+    pub faces: usize,
+    pub control_points: usize,
+    pub t_junctions: usize,
+    pub extraordinary_points: usize,
+    pub holes: usize,
+    pub patches: usize,
+    pub bbox_mm: Aabb,
+}
+
+impl Model {
+    /// Builds the surface of `mesh` and bundles it.
+    pub fn try_new(name: &str, format: &str, units_read: &str, mesh: TMesh) -> Result<Self> {
+        let surface = Surface::try_from_tmesh(&mesh)?;
+        Ok(Model {
+            name: name.to_string(),
+            format: format.to_string(),
+            units_read: units_read.to_string(),
+            mesh,
+            surface,
+        })
+    }
+
+    /// Counts and bounding box.
+    pub fn summary(&self) -> ModelSummary {
+        let nv = self.mesh.vertex_count();
+        ModelSummary {
+            name: self.name.clone(),
+            format: self.format.clone(),
+            units_read: self.units_read.clone(),
+            vertices: nv,
+            faces: self.mesh.faces().len(),
+            control_points: nv,
+            t_junctions: self.mesh.t_junctions().len(),
+            extraordinary_points: (0..nv as u32)
+                .filter(|&v| self.mesh.is_extraordinary(v))
+                .count(),
+            holes: self.mesh.boundary_loops().saturating_sub(1),
+            patches: self.surface.faces().len(),
+            bbox_mm: self.surface.bbox(),
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! Tool path planning: options, the tool path type and report, shared step computations,
+//! and one module per strategy.
+//!
+//! Must not: parse files or write G-code; planners take a [`Model`](crate::model::Model)
+//! and return a [`Toolpath`].
+
+pub mod isoparametric;
+pub mod options;
+pub mod stepover;
+pub mod toolpath;
+
+pub use options::PlanOptions;
+pub use toolpath::{Move, MoveKind, PlanReport, Toolpath};

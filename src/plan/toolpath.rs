@@ -1,0 +1,150 @@
+//! The tool path: ordered moves, each with its cutter-contact point, cutter-location point
+//! (the ball centre), tool axis, patch and iso-line, and the report computed from them.
+
+use crate::geom::{Point3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// What a move does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[repr(u8)]
+pub enum MoveKind {
+    /// Cutting along the surface at the cutting feed.
+    Feed = 0,
+    /// Staying on the surface between two cuts (step-over, patch transit) at cutting feed.
+    Link = 1,
+    /// Leaving the surface along the tool axis to the safe plane.
+    Retract = 2,
+    /// Rapid move above the model (or down to just above the first cut).
+    Rapid = 3,
+    /// Feed move from the approach point onto the surface.
+    Plunge = 4,
+}
+
+/// One position of the tool; the move *ends* here.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Move {
+    pub kind: MoveKind,
+    /// Cutter-contact point on the surface (mm); for moves off the surface, the last one.
+    pub cc_point: Point3,
+    /// Ball centre (mm).
+    pub cl_point: Point3,
+    /// Unit tool axis, from the tip towards the spindle.
+    pub tool_axis: Vector3,
+    /// Patch (domain face) being cut.
+    pub patch: u32,
+    /// Index of the iso-line within its patch.
+    pub line: u32,
+}
+
+/// A complete tool path for one ball-end tool.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Toolpath {
+    pub tool_radius_mm: f64,
+    pub moves: Vec<Move>,
+    /// Largest scallop predicted between adjacent lines by the step-over formula (mm).
+    pub max_predicted_scallop_mm: f64,
+}
+
+/// Summary of a tool path (keys as in the JSON report).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanReport {
+    pub strategy: String,
+    pub length_mm: f64,
+    pub cutting_length_mm: f64,
+    pub link_length_mm: f64,
+    pub rapid_length_mm: f64,
+    pub retractions: usize,
+    pub reversals: usize,
+    pub cl_points: usize,
+    pub patches: usize,
+    pub max_predicted_scallop_mm: f64,
+    pub max_axis_step_deg: f64,
+    /// Estimated machining time at the programmed feeds, rapids at `rapid_mm_min` (min).
+    pub machining_time_min: f64,
+    /// Wall time of planning (ms); filled by the caller, which owns the clock.
+    pub plan_ms: f64,
+}
+
+/// Rapid traverse rate assumed for time estimates (mm/min).
+pub const RAPID_MM_MIN: f64 = 5000.0;
+
+impl Toolpath {
+    /// Lengths, counts and time estimate. `feed` and `plunge_feed` in mm/min.
+    pub fn report(&self, strategy: &str, feed: f64, plunge_feed: f64) -> PlanReport {
+        let mut r = PlanReport {
+            strategy: strategy.to_string(),
+            length_mm: 0.0,
+            cutting_length_mm: 0.0,
+            link_length_mm: 0.0,
+            rapid_length_mm: 0.0,
+            retractions: 0,
+            reversals: 0,
+            cl_points: self.moves.len(),
+            patches: 0,
+            max_predicted_scallop_mm: self.max_predicted_scallop_mm,
+            max_axis_step_deg: 0.0,
+            machining_time_min: 0.0,
+            plan_ms: 0.0,
+        };
+        let mut patches: Vec<u32> = self.moves.iter().map(|m| m.patch).collect();
+        patches.sort_unstable();
+        patches.dedup();
+        r.patches = patches.len();
+        let mut last_dir: Option<Vector3> = None;
+        for w in self.moves.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let d = b.cl_point - a.cl_point;
+            let len = d.norm();
+            r.length_mm += len;
+            match b.kind {
+                MoveKind::Feed => {
+                    r.cutting_length_mm += len;
+                    r.machining_time_min += len / feed;
+                }
+                MoveKind::Link => {
+                    r.link_length_mm += len;
+                    r.machining_time_min += len / feed;
+                }
+                MoveKind::Plunge => {
+                    r.link_length_mm += len;
+                    r.machining_time_min += len / plunge_feed;
+                }
+                MoveKind::Retract | MoveKind::Rapid => {
+                    r.rapid_length_mm += len;
+                    r.machining_time_min += len / RAPID_MM_MIN;
+                }
+            }
+            match b.kind {
+                MoveKind::Feed if len > 0.0 => {
+                    let dir = d / len;
+                    if last_dir.is_some_and(|p: Vector3| p.dot(&dir) < REVERSAL_COS) {
+                        r.reversals += 1;
+                    }
+                    last_dir = Some(dir);
+                }
+                MoveKind::Retract | MoveKind::Rapid => last_dir = None,
+                _ => {}
+            }
+            let cos = a.tool_axis.dot(&b.tool_axis).clamp(-1.0, 1.0);
+            r.max_axis_step_deg = r.max_axis_step_deg.max(cos.acos().to_degrees());
+        }
+        // Retractions between cuts; the final one, after the last cut, does not count.
+        let last_cut = self.moves.iter().rposition(|m| m.kind == MoveKind::Feed);
+        r.retractions = self
+            .moves
+            .iter()
+            .enumerate()
+            .filter(|(i, m)| {
+                m.kind == MoveKind::Retract
+                    && (*i == 0 || self.moves[i - 1].kind != MoveKind::Retract)
+                    && last_cut.is_some_and(|l| *i < l)
+            })
+            .count();
+        r
+    }
+}
+
+/// Two consecutive cutting directions (links between them ignored) with a cosine below this
+/// are a reversal: turning by more than 120°, as at the end of a zig-zag line.
+const REVERSAL_COS: f64 = -0.5;

@@ -1,0 +1,229 @@
+//! The JavaScript API, and the only module with `#[wasm_bindgen]`.
+//!
+//! Large data stays in wasm memory behind opaque handles ([`WasmModel`], [`WasmPlan`]);
+//! JavaScript gets small serde objects (summaries, reports) and flat typed arrays, never one
+//! call per point. Every fallible call returns `Result<_, JsError>`, which arrives in
+//! JavaScript as a thrown `Error` whose message says what to fix.
+
+use crate::error::Error;
+use crate::machine::{self, JobInfo};
+use crate::model::{samples, Model};
+use crate::plan::{isoparametric, PlanOptions, PlanReport, Toolpath};
+use crate::surface::tessellate::{self, Tessellation};
+use wasm_bindgen::prelude::*;
+
+fn js_err(e: Error) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+/// Milliseconds from the JavaScript clock (the only clock in a browser or Node).
+fn now_ms() -> f64 {
+    #[cfg(target_arch = "wasm32")]
+    {
+        js_sys::Date::now()
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        0.0
+    }
+}
+
+/// Names of the built-in sample models.
+#[wasm_bindgen(js_name = sampleNames)]
+pub fn sample_names() -> Vec<String> {
+    samples::SAMPLES
+        .iter()
+        .map(|s| s.name.to_string())
+        .collect()
+}
+
+/// The crate version, for page footers and G-code headers.
+#[wasm_bindgen]
+pub fn version() -> String {
+    env!("CARGO_PKG_VERSION").to_string()
+}
+
+/// A loaded model, held in wasm memory.
+#[wasm_bindgen(js_name = Model)]
+pub struct WasmModel {
+    model: Model,
+}
+
+#[wasm_bindgen(js_class = Model)]
+impl WasmModel {
+    /// Loads a model file from its bytes; the format (JSON T-mesh, .tsm, .obj) is detected
+    /// from the content. `name` is used when the file carries none.
+    #[wasm_bindgen(js_name = fromBytes)]
+    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<WasmModel, JsError> {
+        crate::io::load(bytes, name)
+            .map(|model| WasmModel { model })
+            .map_err(js_err)
+    }
+
+    /// A built-in sample model.
+    pub fn sample(name: &str) -> Result<WasmModel, JsError> {
+        samples::load_sample(name)
+            .map(|model| WasmModel { model })
+            .map_err(js_err)
+    }
+
+    /// The model's name.
+    #[wasm_bindgen(getter)]
+    pub fn name(&self) -> String {
+        self.model.name.clone()
+    }
+
+    /// Counts and bounding box: `{name, format, vertices, faces, control_points, t_junctions,
+    /// extraordinary_points, holes, patches, bbox_mm: {min, max}}`.
+    pub fn summary(&self) -> Result<JsValue, JsError> {
+        serde_wasm_bindgen::to_value(&self.model.summary())
+            .map_err(|e| JsError::new(&e.to_string()))
+    }
+
+    /// Triangles of the surface within `chordal_mm` (mm) of it.
+    pub fn tessellate(&self, chordal_mm: f64) -> Result<WasmMesh, JsError> {
+        if !(chordal_mm.is_finite() && chordal_mm > 0.0) {
+            return Err(js_err(Error::param(
+                "chordal_mm",
+                format!("must be a positive number of mm, got {chordal_mm}"),
+            )));
+        }
+        Ok(WasmMesh {
+            mesh: tessellate::tessellate(&self.model.surface, chordal_mm),
+        })
+    }
+
+    /// Plans the isoparametric zig-zag. `options` is a plain object with any of the
+    /// [`PlanOptions`] fields (`tool_radius_mm`, `scallop_mm`, `chordal_mm`, ...);
+    /// `progress`, if given, is called with the fraction done and may return `false` to
+    /// cancel.
+    pub fn plan(
+        &self,
+        options: JsValue,
+        progress: Option<js_sys::Function>,
+    ) -> Result<WasmPlan, JsError> {
+        let opts: PlanOptions = if options.is_undefined() || options.is_null() {
+            PlanOptions::default()
+        } else {
+            serde_wasm_bindgen::from_value(options)
+                .map_err(|e| JsError::new(&format!("invalid plan options: {e}")))?
+        };
+        let t0 = now_ms();
+        let mut cb = |f: f64| -> bool {
+            match &progress {
+                Some(func) => func
+                    .call1(&JsValue::NULL, &JsValue::from_f64(f))
+                    .map(|r| r.as_bool() != Some(false))
+                    .unwrap_or(true),
+                None => true,
+            }
+        };
+        let path = isoparametric::plan_zigzag(&self.model, &opts, &mut cb).map_err(js_err)?;
+        let mut report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
+        report.plan_ms = now_ms() - t0;
+        let gcode = machine::gcode_3axis(
+            &path,
+            &opts,
+            &JobInfo {
+                model: self.model.name.clone(),
+                strategy: "isoparametric".into(),
+            },
+        );
+        Ok(WasmPlan {
+            path,
+            report,
+            gcode,
+        })
+    }
+}
+
+/// A tessellation, copied out as typed arrays.
+#[wasm_bindgen(js_name = SurfaceMesh)]
+pub struct WasmMesh {
+    mesh: Tessellation,
+}
+
+#[wasm_bindgen(js_class = SurfaceMesh)]
+impl WasmMesh {
+    /// `x y z` per vertex (mm).
+    pub fn positions(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(&self.mesh.positions[..])
+    }
+    /// Unit normal per vertex.
+    pub fn normals(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(&self.mesh.normals[..])
+    }
+    /// Three vertex indices per triangle.
+    pub fn indices(&self) -> js_sys::Uint32Array {
+        js_sys::Uint32Array::from(&self.mesh.indices[..])
+    }
+    /// Patch of each triangle.
+    #[wasm_bindgen(js_name = patchIds)]
+    pub fn patch_ids(&self) -> js_sys::Uint32Array {
+        js_sys::Uint32Array::from(&self.mesh.patch_ids[..])
+    }
+}
+
+/// A planned tool path with its report and G-code.
+#[wasm_bindgen(js_name = Plan)]
+pub struct WasmPlan {
+    path: Toolpath,
+    report: PlanReport,
+    gcode: String,
+}
+
+#[wasm_bindgen(js_class = Plan)]
+impl WasmPlan {
+    /// Ball-centre points `x y z` per move (mm).
+    #[wasm_bindgen(js_name = clPoints)]
+    pub fn cl_points(&self) -> js_sys::Float64Array {
+        let v: Vec<f64> = self
+            .path
+            .moves
+            .iter()
+            .flat_map(|m| [m.cl_point.x, m.cl_point.y, m.cl_point.z])
+            .collect();
+        js_sys::Float64Array::from(&v[..])
+    }
+    /// Cutter-contact points `x y z` per move (mm).
+    #[wasm_bindgen(js_name = ccPoints)]
+    pub fn cc_points(&self) -> js_sys::Float64Array {
+        let v: Vec<f64> = self
+            .path
+            .moves
+            .iter()
+            .flat_map(|m| [m.cc_point.x, m.cc_point.y, m.cc_point.z])
+            .collect();
+        js_sys::Float64Array::from(&v[..])
+    }
+    /// Unit tool axes `x y z` per move.
+    pub fn axes(&self) -> js_sys::Float64Array {
+        let v: Vec<f64> = self
+            .path
+            .moves
+            .iter()
+            .flat_map(|m| [m.tool_axis.x, m.tool_axis.y, m.tool_axis.z])
+            .collect();
+        js_sys::Float64Array::from(&v[..])
+    }
+    /// Move kind per move: 0 feed, 1 link, 2 retract, 3 rapid, 4 plunge.
+    #[wasm_bindgen(js_name = moveKinds)]
+    pub fn move_kinds(&self) -> js_sys::Uint8Array {
+        let v: Vec<u8> = self.path.moves.iter().map(|m| m.kind as u8).collect();
+        js_sys::Uint8Array::from(&v[..])
+    }
+    /// Patch per move.
+    #[wasm_bindgen(js_name = patchIds)]
+    pub fn patch_ids(&self) -> js_sys::Uint32Array {
+        let v: Vec<u32> = self.path.moves.iter().map(|m| m.patch).collect();
+        js_sys::Uint32Array::from(&v[..])
+    }
+    /// The report: lengths (mm), counts, predicted scallop (mm), time (min), `plan_ms`.
+    pub fn report(&self) -> Result<JsValue, JsError> {
+        serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))
+    }
+    /// The G-code program (mm).
+    pub fn gcode(&self) -> String {
+        self.gcode.clone()
+    }
+}

@@ -1,0 +1,105 @@
+//! The exported JavaScript API, run as wasm in headless Node by wasm-bindgen-test-runner:
+//! `cargo test --target wasm32-unknown-unknown --test wasm_api` (see scripts/test).
+#![cfg(target_arch = "wasm32")]
+
+use tspath::wasm::{sample_names, WasmModel as Model};
+use wasm_bindgen::{JsCast, JsValue};
+use wasm_bindgen_test::*;
+
+/// The message of the JavaScript `Error` a failed call throws.
+fn js_message(e: wasm_bindgen::JsError) -> String {
+    let v: JsValue = e.into();
+    let err: js_sys::Error = v
+        .dyn_into()
+        .expect("errors arrive in JavaScript as Error objects");
+    err.message().into()
+}
+
+fn get(obj: &JsValue, key: &str) -> JsValue {
+    js_sys::Reflect::get(obj, &JsValue::from_str(key)).unwrap()
+}
+
+#[wasm_bindgen_test]
+fn sample_loads_plans_and_posts() {
+    assert!(sample_names().iter().any(|n| n == "dome"));
+    let model = Model::sample("dome").unwrap();
+    let summary = model.summary().unwrap();
+    assert_eq!(get(&summary, "patches").as_f64(), Some(1.0));
+    let bbox = get(&summary, "bbox_mm");
+    let max = js_sys::Array::from(&get(&bbox, "max"));
+    assert!(
+        (max.get(2).as_f64().unwrap() - 20.0).abs() < 1e-9,
+        "dome apex at z = 20 mm"
+    );
+
+    let mesh = model.tessellate(0.01).unwrap();
+    let positions = mesh.positions();
+    let indices = mesh.indices();
+    assert_eq!(positions.length() % 3, 0);
+    assert!(indices.length() >= 3 * 8);
+    assert_eq!(mesh.patch_ids().length() * 3, indices.length());
+
+    let options = js_sys::Object::new();
+    js_sys::Reflect::set(&options, &"tool_radius_mm".into(), &2.0.into()).unwrap();
+    js_sys::Reflect::set(&options, &"scallop_mm".into(), &0.02.into()).unwrap();
+    let calls = js_sys::Array::new();
+    let progress = js_sys::Function::new_with_args("f", "this.push(f); return true;").bind0(&calls);
+    let plan = model.plan(options.into(), Some(progress)).unwrap();
+    assert!(calls.length() > 1, "progress is reported while planning");
+    let last = calls.get(calls.length() - 1).as_f64().unwrap();
+    assert!((last - 1.0).abs() < 1e-12, "progress ends at 1, got {last}");
+
+    let cl = plan.cl_points();
+    let kinds = plan.move_kinds();
+    assert_eq!(cl.length(), 3 * kinds.length());
+    assert_eq!(plan.axes().length(), cl.length());
+    let report = plan.report().unwrap();
+    assert_eq!(
+        get(&report, "cl_points").as_f64(),
+        Some(kinds.length() as f64)
+    );
+    assert!(get(&report, "max_predicted_scallop_mm").as_f64().unwrap() <= 0.02 * (1.0 + 1e-9));
+    let gcode = plan.gcode();
+    assert!(gcode.contains("G21") && gcode.contains("(model: dome)"));
+    assert!(gcode.lines().filter(|l| l.starts_with("G1 ")).count() > 100);
+}
+
+#[wasm_bindgen_test]
+fn cancel_from_progress_callback() {
+    let model = Model::sample("dome").unwrap();
+    let stop = js_sys::Function::new_with_args("f", "return f < 0.2;");
+    let msg = js_message(
+        model
+            .plan(JsValue::UNDEFINED, Some(stop))
+            .err()
+            .expect("cancelled"),
+    );
+    assert_eq!(msg, "cancelled");
+}
+
+#[wasm_bindgen_test]
+fn malformed_models_throw_errors_with_reasons() {
+    let cases: &[(&[u8], &str)] = &[
+        (b"", "empty"),
+        (b"{\"format\": \"tspath-tmesh\", \"version\": 1, \"points\": [[0, 0", "line 1"),
+        (b"{\"format\": \"tspath-tmesh\", \"version\": 1, \"points\": [], \"faces\": [[0, 1, 2, 3]]}", "vertex"),
+        (&[0xff, 0xfe, 0x00, 0x13, 0x99], "not a model file"),
+    ];
+    for (bytes, needle) in cases {
+        let msg = js_message(Model::from_bytes(bytes, "bad").err().expect("must fail"));
+        assert!(
+            msg.contains(needle),
+            "message `{msg}` should mention `{needle}`"
+        );
+    }
+}
+
+#[wasm_bindgen_test]
+fn impossible_parameters_throw() {
+    let model = Model::sample("dome").unwrap();
+    let options = js_sys::Object::new();
+    js_sys::Reflect::set(&options, &"scallop_mm".into(), &(-1.0).into()).unwrap();
+    let msg = js_message(model.plan(options.into(), None).err().expect("must fail"));
+    assert!(msg.contains("scallop_mm"), "{msg}");
+    assert!(js_message(model.tessellate(0.0).err().unwrap()).contains("chordal"));
+}
