@@ -5,6 +5,7 @@
 //! not from a file name, so the page and the CLI accept the same bytes.
 
 pub mod json;
+pub mod obj;
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -73,6 +74,10 @@ pub fn load(bytes: &[u8], name: &str) -> Result<Model> {
                 &meta.name
             };
             Model::try_new(name, "json", &meta.units, mesh)
+        }
+        Format::Obj => {
+            let text = String::from_utf8_lossy(bytes);
+            Model::try_new(name, "obj", "mm (assumed)", obj::read(&text)?)
         }
         f => Err(Error::Unsupported(format!(
             "{} files are not readable by this build yet",
