@@ -180,7 +180,16 @@ fn local_one_ring(mesh: &TMesh, f: u32) -> Result<(LocalMesh, u32)> {
     let q = faces
         .binary_search(&f)
         .expect("the face is in its own ring") as u32;
-    Ok((LocalMesh { pts, quads, sharp }, q))
+    let origin = crate::geom::Vector3::zeros();
+    Ok((
+        LocalMesh {
+            pts,
+            origin,
+            quads,
+            sharp,
+        },
+        q,
+    ))
 }
 
 /// Bézier extraction of a T-spline face.

@@ -28,7 +28,12 @@ pub const MAX_DEPTH: usize = 40;
 /// or only where the cut ended.
 #[derive(Debug, Clone)]
 pub struct LocalMesh {
+    /// Homogeneous points, relative to `origin`.
     pub pts: Vec<Vector4>,
+    /// Where the coordinates are measured from (mm). Subdivision near an extraordinary
+    /// point re-centres on its limit point at every level, so that coordinates shrink with
+    /// the region and keep their relative precision down to the deepest cells.
+    pub origin: Vector3,
     pub quads: Vec<[u32; 4]>,
     /// Undirected edges `(min, max)` that lie on the model's boundary.
     pub sharp: std::collections::HashSet<(u32, u32)>,
@@ -39,8 +44,9 @@ pub struct LocalMesh {
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub enum Node {
-    /// A regular region: one Bézier cell over the node's square.
-    Leaf(BezierPatch),
+    /// A regular region: one Bézier cell over the node's square, with coordinates measured
+    /// from `origin` (mm).
+    Leaf { patch: BezierPatch, origin: Vector3 },
     /// Four children: `[u low v low, u high v low, u low v high, u high v high]`.
     Split(Box<[Node; 4]>),
     /// The tiny region at an extraordinary point: its limit point (homogeneous).
@@ -54,7 +60,11 @@ impl Node {
         let mut scale = 1.0;
         loop {
             match node {
-                Node::Leaf(p) => return p.derivs(u, v).scaled(scale, scale),
+                Node::Leaf { patch, origin } => {
+                    let mut d = patch.derivs(u, v).scaled(scale, scale);
+                    d.point += origin;
+                    return d;
+                }
                 Node::Cap(h) => {
                     return SurfaceDerivs {
                         point: Point3::new(h.x / h.w, h.y / h.w, h.z / h.w),
@@ -81,7 +91,7 @@ impl Node {
         let mut node = self;
         loop {
             match node {
-                Node::Leaf(p) => return p.subs(u, v),
+                Node::Leaf { patch, origin } => return patch.subs(u, v) + origin,
                 Node::Cap(h) => return Point3::new(h.x / h.w, h.y / h.w, h.z / h.w),
                 Node::Split(ch) => {
                     let (hu, hv) = (u >= 0.5, v >= 0.5);
@@ -96,17 +106,25 @@ impl Node {
     /// Number of Bézier cells.
     pub fn leaf_count(&self) -> usize {
         match self {
-            Node::Leaf(_) => 1,
+            Node::Leaf { .. } => 1,
             Node::Cap(_) => 0,
             Node::Split(ch) => ch.iter().map(Node::leaf_count).sum(),
         }
     }
 
-    /// Calls `f` with each leaf's square `[u0, u1, v0, v1]` and patch.
+    /// Calls `f` with each leaf's square `[u0, u1, v0, v1]` and patch (in model
+    /// coordinates).
     pub fn for_each_leaf(&self, f: &mut dyn FnMut([f64; 4], &BezierPatch)) {
         fn walk(n: &Node, r: [f64; 4], f: &mut dyn FnMut([f64; 4], &BezierPatch)) {
             match n {
-                Node::Leaf(p) => f(r, p),
+                Node::Leaf { patch, origin } => {
+                    let mut p = patch.clone();
+                    for c in p.cp.iter_mut().flatten() {
+                        let w = c.w;
+                        *c += Vector4::new(origin.x * w, origin.y * w, origin.z * w, 0.0);
+                    }
+                    f(r, &p)
+                }
                 Node::Cap(_) => {}
                 Node::Split(ch) => {
                     let um = 0.5 * (r[0] + r[1]);
@@ -289,7 +307,22 @@ impl LocalMesh {
                 sharp.insert(edge_key(e, b));
             }
         }
-        LocalMesh { pts, quads, sharp }
+        LocalMesh {
+            pts,
+            origin: self.origin,
+            quads,
+            sharp,
+        }
+    }
+
+    /// The same mesh with coordinates measured from `origin + shift` (mm).
+    fn recentred(mut self, shift: Vector3) -> LocalMesh {
+        for p in self.pts.iter_mut() {
+            let w = p.w;
+            *p -= Vector4::new(shift.x * w, shift.y * w, shift.z * w, 0.0);
+        }
+        self.origin += shift;
+        self
     }
 
     /// The quads sharing a vertex with quad `q`, as a new local mesh; returns it and the
@@ -323,7 +356,15 @@ impl LocalMesh {
             .filter_map(|&(a, b)| Some(edge_key(*map.get(&a)?, *map.get(&b)?)))
             .collect();
         let idx = keep.binary_search(&q).expect("q is in its own one-ring") as u32;
-        (LocalMesh { pts, quads, sharp }, idx)
+        (
+            LocalMesh {
+                pts,
+                origin: self.origin,
+                quads,
+                sharp,
+            },
+            idx,
+        )
     }
 
     /// The 16 control points of quad `q` as a uniform bicubic B-spline patch, indexed
@@ -468,28 +509,37 @@ impl LocalMesh {
 
     fn tree_at(&self, q: u32, depth: usize) -> Node {
         if let Some(grid) = self.regular_grid(q) {
-            return Node::Leaf(bspline_to_bezier(&grid));
+            return Node::Leaf {
+                patch: bspline_to_bezier(&grid),
+                origin: self.origin,
+            };
         }
         let (ring, qi) = self.one_ring(q);
+        // The irregular corner: the one whose vertex is not regular. Measure from its limit
+        // point so the coordinates shrink with the region.
+        let adj = Adjacency::new(&ring);
+        let quad = ring.quads[qi as usize];
+        let corner = quad
+            .iter()
+            .copied()
+            .find(|&c| {
+                !matches!(
+                    ring.vertex_kind(&adj, c),
+                    VertexKind::Interior { faces: 4 } | VertexKind::Boundary { faces: 1 | 2 }
+                )
+            })
+            .unwrap_or(quad[0]);
+        let limit = ring.limit_point(corner);
         if depth >= MAX_DEPTH {
-            // The irregular corner: the one whose vertex is not regular.
-            let adj = Adjacency::new(&ring);
-            let quad = ring.quads[qi as usize];
-            let corner = quad
-                .iter()
-                .copied()
-                .find(|&c| {
-                    !matches!(
-                        ring.vertex_kind(&adj, c),
-                        VertexKind::Interior { faces: 4 } | VertexKind::Boundary { faces: 1 | 2 }
-                    )
-                })
-                .unwrap_or(quad[0]);
-            return Node::Cap(ring.limit_point(corner));
+            let o = ring.origin;
+            return Node::Cap(
+                limit + Vector4::new(o.x * limit.w, o.y * limit.w, o.z * limit.w, 0.0),
+            );
         }
+        let ring = ring.recentred(limit.xyz() / limit.w);
         let fine = ring.subdivide();
         let base = 4 * qi;
-        // Children are stored [ll, lh(u high), hh, hl(v high)]; the tree wants
+        // Children are stored [ll, u high, both high, v high]; the tree wants
         // [ll, u high, v high, both high].
         let c = |k: u32| fine.tree_at(base + k, depth + 1);
         Node::Split(Box::new([c(0), c(1), c(3), c(2)]))
