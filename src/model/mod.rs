@@ -7,6 +7,7 @@ pub mod samples;
 
 use crate::error::Result;
 use crate::geom::Aabb;
+use crate::layout::PatchLayout;
 use crate::surface::Surface;
 use crate::tmesh::TMesh;
 use serde::{Deserialize, Serialize};
@@ -21,6 +22,7 @@ pub struct Model {
     pub units_read: String,
     pub mesh: TMesh,
     pub surface: Surface,
+    pub layout: PatchLayout,
 }
 
 /// Counts and size of a model, as shown by `tspath info` and the page.
@@ -43,7 +45,9 @@ impl Model {
     /// Builds the surface of `mesh` and bundles it.
     pub fn try_new(name: &str, format: &str, units_read: &str, mesh: TMesh) -> Result<Self> {
         let surface = Surface::try_from_tmesh(&mesh)?;
+        let layout = PatchLayout::build(&mesh, &surface);
         Ok(Model {
+            layout,
             name: name.to_string(),
             format: format.to_string(),
             units_read: units_read.to_string(),
@@ -67,7 +71,7 @@ impl Model {
                 .filter(|&v| self.mesh.is_extraordinary(v))
                 .count(),
             holes: self.mesh.boundary_loops().saturating_sub(1),
-            patches: self.surface.faces().len(),
+            patches: self.layout.len(),
             bbox_mm: self.surface.bbox(),
         }
     }

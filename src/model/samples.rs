@@ -68,8 +68,8 @@ pub const SAMPLES: &[SampleInfo] = &[
     },
     SampleInfo {
         name: "plate-hole",
-        description: "a gently curved plate, 80 × 60 mm, with a rectangular hole and a notched corner (irregular boundary), Catmull–Clark (sharp boundaries, corners interpolated); its 5 extraordinary points are the hole's corners and the notch's inner corner",
-        patches: 0,
+        description: "a gently curved plate, 80 × 60 mm, with a rectangular hole and a notched corner (irregular boundary), Catmull–Clark (sharp boundaries, corners interpolated); its 5 extraordinary points are the hole's corners and the notch's inner corner; 10 patches",
+        patches: 10,
         extraordinary_points: 5,
         size_mm: [80.0, 60.0, 0.0],
     },
@@ -89,8 +89,8 @@ pub const SAMPLES: &[SampleInfo] = &[
     },
     SampleInfo {
         name: "bumps-hole",
-        description: "synthetic plate, 80 × 60 mm, with a convex bump, a concave dimple and a square hole between them, Catmull–Clark; its 4 extraordinary points are the hole's corners",
-        patches: 0,
+        description: "synthetic plate, 80 × 60 mm, with a convex bump, a concave dimple and a square hole between them, Catmull–Clark; its 4 extraordinary points are the hole's corners; 8 patches around the hole",
+        patches: 8,
         extraordinary_points: 4,
         size_mm: [80.0, 60.0, 0.0],
     },
