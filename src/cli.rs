@@ -11,6 +11,7 @@ const USAGE: &str = "usage:
   tspath info MODEL
   tspath sample --list
   tspath sample NAME -o FILE.json
+  tspath export MODEL -o FILE.stl|FILE.obj [--chordal MM]
   tspath plan MODEL [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [-o OUT.nc] [--report REPORT.json]
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
@@ -26,6 +27,7 @@ pub fn run(args: &[String]) -> Result<String> {
         "info" => info(rest),
         "sample" => sample(rest),
         "plan" => plan(rest),
+        "export" => export(rest),
         "-h" | "--help" | "help" => Ok(USAGE.into()),
         other => Err(Error::Io(format!("unknown command `{other}`\n{USAGE}"))),
     }
@@ -137,6 +139,42 @@ fn sample(args: &[String]) -> Result<String> {
         }
         None => Ok(json),
     }
+}
+
+fn export(args: &[String]) -> Result<String> {
+    let a = parse(args, &["-o", "--chordal"], &[])?;
+    let [model] = a.positional[..] else {
+        return Err(Error::Io(format!("export takes one MODEL\n{USAGE}")));
+    };
+    let out = a
+        .value("-o")
+        .ok_or_else(|| Error::Io(format!("export needs -o FILE.stl or FILE.obj\n{USAGE}")))?;
+    let chordal = a.number("--chordal")?.unwrap_or(0.01);
+    if !(chordal.is_finite() && chordal > 0.0) {
+        return Err(Error::param(
+            "chordal_mm",
+            format!("must be a positive number of mm, got {chordal}"),
+        ));
+    }
+    let m = load_model(model)?;
+    let t = m.tessellate(chordal);
+    let lower = out.to_ascii_lowercase();
+    if lower.ends_with(".stl") {
+        std::fs::write(out, crate::io::export::stl(&t, &m.name))
+            .map_err(|e| Error::Io(format!("cannot write {out}: {e}")))?;
+    } else if lower.ends_with(".obj") {
+        write_file(out, &crate::io::export::obj(&t, &m.name))?;
+    } else {
+        return Err(Error::Io(format!(
+            "{out}: the output must end in .stl or .obj"
+        )));
+    }
+    Ok(format!(
+        "{}: {} triangles, {} vertices, chordal tolerance {chordal} mm\n",
+        out,
+        t.indices.len() / 3,
+        t.positions.len() / 3
+    ))
 }
 
 fn plan(args: &[String]) -> Result<String> {

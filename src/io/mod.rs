@@ -4,6 +4,7 @@
 //! Formats: the project's JSON T-mesh ([`json`]). The format is detected from the content,
 //! not from a file name, so the page and the CLI accept the same bytes.
 
+pub mod export;
 pub mod json;
 pub mod obj;
 

@@ -56,6 +56,11 @@ impl Model {
         })
     }
 
+    /// Watertight triangles within `chordal_mm` of the surface, with patch ids.
+    pub fn tessellate(&self, chordal_mm: f64) -> crate::surface::tessellate::Tessellation {
+        crate::surface::tessellate::tessellate(&self.mesh, &self.surface, &self.layout, chordal_mm)
+    }
+
     /// Counts and bounding box.
     pub fn summary(&self) -> ModelSummary {
         let nv = self.mesh.vertex_count();

@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::machine::{self, JobInfo};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions, PlanReport, Toolpath};
-use crate::surface::tessellate::{self, Tessellation};
+use crate::surface::tessellate::Tessellation;
 use wasm_bindgen::prelude::*;
 
 fn js_err(e: Error) -> JsError {
@@ -89,7 +89,7 @@ impl WasmModel {
             )));
         }
         Ok(WasmMesh {
-            mesh: tessellate::tessellate(&self.model.surface, chordal_mm),
+            mesh: self.model.tessellate(chordal_mm),
         })
     }
 
