@@ -2,6 +2,9 @@
 //! the planned ball centres and tool axes; inch and mm programs describe the same motion;
 //! the same input gives the same bytes.
 
+// Index loops over X Y Z A B C read like the axes they compare.
+#![allow(clippy::needless_range_loop)]
+
 mod machine_support;
 
 use machine_support::*;

@@ -15,7 +15,8 @@
 //!      "direction": 1, "limits_deg": null}
 //!   ],
 //!   "linear_limits_mm": {"x": [-400, 400], "y": null, "z": null},
-//!   "max_rotary_feed_deg_min": 5400
+//!   "max_rotary_feed_deg_min": 5400,
+//!   "safe_z_machine_mm": 0
 //! }
 //! ```
 //! The README's "Machines" section documents every field.
@@ -78,6 +79,8 @@ struct MachineFile {
     linear_limits_mm: Option<LimitsFile>,
     #[serde(default = "default_rotary_feed")]
     max_rotary_feed_deg_min: f64,
+    #[serde(default)]
+    safe_z_machine_mm: f64,
 }
 
 /// A built-in machine: its name and what it is.
@@ -178,6 +181,7 @@ pub fn builtin(name: &str) -> Result<Machine> {
         rotaries,
         linear_limits_mm: LinearLimits::default(),
         max_rotary_feed_deg_min: DEFAULT_ROTARY_FEED_DEG_MIN,
+        safe_z_machine_mm: 0.0,
     };
     m.validate()?;
     Ok(m)
@@ -246,6 +250,7 @@ pub fn from_json(text: &str) -> Result<Machine> {
             z: pair(l.z),
         },
         max_rotary_feed_deg_min: f.max_rotary_feed_deg_min,
+        safe_z_machine_mm: f.safe_z_machine_mm,
     };
     m.validate()?;
     Ok(m)
@@ -277,6 +282,7 @@ pub fn to_json(m: &Machine) -> String {
             z: pair(m.linear_limits_mm.z),
         }),
         max_rotary_feed_deg_min: m.max_rotary_feed_deg_min,
+        safe_z_machine_mm: m.safe_z_machine_mm,
     };
     serde_json::to_string_pretty(&f).expect("a machine serialises") + "\n"
 }

@@ -87,6 +87,9 @@ pub struct Machine {
     /// Fastest rotary motion (degrees per minute); bounds inverse-time feeds of moves that
     /// mostly turn.
     pub max_rotary_feed_deg_min: f64,
+    /// Machine-coordinate Z (mm) of the safe spindle position at program start and end
+    /// (G53 / SUPA / M91 blocks); 0 on machines homed at the top of Z.
+    pub safe_z_machine_mm: f64,
 }
 
 /// Joint values of one pose: linear axes (mm) and rotary angles (degrees) in the order of
@@ -187,6 +190,12 @@ impl Machine {
                     "must be a positive number of degrees per minute, got {}",
                     self.max_rotary_feed_deg_min
                 ),
+            );
+        }
+        if !self.safe_z_machine_mm.is_finite() {
+            return bad(
+                "safe_z_machine_mm".into(),
+                format!("must be a number of mm, got {}", self.safe_z_machine_mm),
             );
         }
         if !(self.rotaries.is_empty() || self.rotaries.len() == 2) {

@@ -13,10 +13,11 @@
 //! `siemens` TRAORI) write the *tool tip* in the workpiece frame plus the rotary angles;
 //! the controller moves the linear axes and keeps the programmed feed at the tip (G94).
 //!
-//! Safe start: the spindle goes to the top of Z in machine coordinates before the tool change,
+//! Safe start: the spindle goes to the machine's safe Z (`safe_z_machine_mm`, in machine
+//! coordinates: G53, SUPA or M91; usually the top of travel) before the tool change,
 //! the rotaries turn to the first orientation up there, then the path starts. Safe end: a
 //! retract along the tool axis to the clearance height (the highest cutting point along that
-//! axis plus `clearance_mm`) unless the path already ends there, then the top of Z again.
+//! axis plus `clearance_mm`) unless the path already ends there, then the safe Z again.
 
 use super::joints::{self, PoseRequest};
 use super::kinematics::{Joints, Kinematics, Machine};
@@ -547,7 +548,7 @@ pub fn post_program(
     let safe_top = |source| Motion {
         rapid: true,
         machine_frame: true,
-        xyz: [None, None, Some(0.0)],
+        xyz: [None, None, Some(machine.safe_z_machine_mm)],
         rotary: Vec::new(),
         feed_mode: None,
         feed: None,

@@ -119,6 +119,7 @@ pub fn scratch(name: &str) -> PathBuf {
 /// What `rs274` made of a file.
 pub struct Rs274 {
     pub accepted: bool,
+    pub status: Option<i32>,
     pub stdout: String,
     /// The interpreter's message (stderr without its `executing` lines).
     pub message: String,
@@ -136,7 +137,11 @@ pub fn rs274(file: &Path, tool_radius_mm: f64) -> Rs274 {
         format!("T1 P1 Z0 D{:.6} ;ball-end\n", 2.0 * tool_radius_mm / 25.4),
     )
     .unwrap();
+    // rs274 maps its tool table through `$HOME/.tool.mmap`, truncating it at start: two runs
+    // sharing a HOME crash each other (bus error). Each scratch directory is its own HOME.
     let out = Command::new("rs274")
+        .env("HOME", dir)
+        .current_dir(dir)
         .arg("-g")
         .arg("-t")
         .arg(&table)
@@ -159,6 +164,7 @@ pub fn rs274(file: &Path, tool_radius_mm: f64) -> Rs274 {
         accepted: out.status.success()
             && message.trim().is_empty()
             && stdout.contains("PROGRAM_END"),
+        status: out.status.code(),
         stdout,
         message,
     }
