@@ -177,3 +177,71 @@ fn same_input_same_bytes_in_every_dialect() {
         }
     }
 }
+
+/// Samples of each move where the machine's joint interpolation is checked.
+const INTERPOLATION_SAMPLES: usize = 16;
+
+#[test]
+fn joint_space_moves_stay_within_the_chordal_tolerance_of_the_planned_chords() {
+    // A controller interpolating joint values linearly moves the ball centre off the straight
+    // chord where the rotaries turn fast (near the singular pose). Read every joint-value
+    // program back, interpolate its joints as LinuxCNC would, and measure that deviation.
+    let o = opts();
+    for (name, planned) in sample_plans() {
+        let path = along_normals(&planned);
+        for m in MACHINES {
+            let mach = machine::builtin(m.name).unwrap();
+            if mach.rotaries.is_empty() {
+                continue;
+            }
+            let posted = machine::post::post_program(
+                &path,
+                &o,
+                &job(&name),
+                &mach,
+                Dialect::LinuxCnc,
+                Units::Mm,
+            )
+            .unwrap();
+            let prog = reader::read(&posted.text).unwrap();
+            let mut worst: f64 = 0.0;
+            for w in prog.moves.windows(2) {
+                let (a, b) = (&w[0], &w[1]);
+                if b.feed_mode == reader::FeedMode::Rapid || a.machine_frame || a.xyz_mm[0].is_nan()
+                {
+                    continue;
+                }
+                let joints = |t: f64| {
+                    let mut rot = [0.0; 2];
+                    for (i, r) in mach.rotaries.iter().enumerate() {
+                        let k = (r.name as u8 - b'A') as usize;
+                        rot[i] = a.abc_deg[k] + (b.abc_deg[k] - a.abc_deg[k]) * t;
+                    }
+                    machine::Joints {
+                        xyz_mm: [0, 1, 2].map(|k| a.xyz_mm[k] + (b.xyz_mm[k] - a.xyz_mm[k]) * t),
+                        rotary_deg: rot,
+                    }
+                };
+                let centre = |t: f64| {
+                    let p = mach.forward(&joints(t));
+                    p.tip + p.axis * path.tool_radius_mm
+                };
+                let (c0, c1) = (centre(0.0), centre(1.0));
+                for s in 1..INTERPOLATION_SAMPLES {
+                    let t = s as f64 / INTERPOLATION_SAMPLES as f64;
+                    let d = (centre(t) - (c0 + (c1 - c0) * t)).norm();
+                    worst = worst.max(d);
+                }
+            }
+            assert!(
+                worst <= o.chordal_mm + 1e-3,
+                "{}: joint interpolation leaves the chord by {worst} mm",
+                m.name
+            );
+            println!(
+                "{} on {name} along normals: {} blocks inserted; joint interpolation stays within {worst:.4} mm of the chords (chordal tolerance {} mm)",
+                m.name, posted.inserted, o.chordal_mm
+            );
+        }
+    }
+}

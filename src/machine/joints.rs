@@ -80,9 +80,16 @@ fn outside_text(machine: &Machine, s: &RotarySolution) -> String {
         .join(", ")
 }
 
+/// Joint values and the orientation branch they are on (`None` at the singular pose).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Solved {
+    pub joints: Joints,
+    pub branch: Option<u8>,
+}
+
 /// The joint values of every pose, or the first move the machine cannot do.
-pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
-    let mut out: Vec<Joints> = Vec::with_capacity(poses.len());
+pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Solved>> {
+    let mut out: Vec<Solved> = Vec::with_capacity(poses.len());
     let mut previous = [0.0; 2];
     let mut start = 0;
     while start < poses.len() {
@@ -121,7 +128,7 @@ pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
         let mut first_error = None;
         let mut chain = None;
         for c in &candidates {
-            match follow(machine, poses, start, end, c.rotary_deg) {
+            match follow(machine, poses, start, end, c) {
                 Ok(j) => {
                     chain = Some(j);
                     break;
@@ -133,7 +140,7 @@ pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
         }
         match chain {
             Some(j) => {
-                previous = j.last().map(|l| l.rotary_deg).unwrap_or(previous);
+                previous = j.last().map(|l| l.joints.rotary_deg).unwrap_or(previous);
                 out.extend(j);
             }
             None => return Err(first_error.expect("at least one candidate was tried")),
@@ -143,69 +150,212 @@ pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
     Ok(out)
 }
 
-/// Follows one chain from the rotary pose `seed` at `start`, nearest solution each move.
+fn branch_of(s: &RotarySolution) -> Option<u8> {
+    (!s.singular).then_some(s.branch)
+}
+
+/// The rotary solution for `axis` nearest `previous` within the limits, on the same branch as
+/// `previous` unless the arc of tool axes from `previous_axis` meets the singular pose; an
+/// error naming move `i` when the limits would force a swing (the nearest solution is
+/// outside them).
+fn continue_to(
+    machine: &Machine,
+    axis: &Vector3,
+    previous_axis: &Vector3,
+    previous: [f64; 2],
+    previous_branch: Option<u8>,
+    i: usize,
+) -> Result<RotarySolution> {
+    let free_branch = previous_branch.is_none() || machine.arc_meets_singular(previous_axis, axis);
+    let keep = |s: &RotarySolution| free_branch || s.singular || Some(s.branch) == previous_branch;
+    let solutions = |limits: bool| -> Result<Vec<RotarySolution>> {
+        let all = machine
+            .rotary_solutions(axis, previous, limits)
+            .map_err(|Unreachable| unreachable(machine, i, axis))?;
+        let same: Vec<RotarySolution> = all.iter().copied().filter(keep).collect();
+        // A branch can end where two solutions merge (the edge of what a tilted axis reaches).
+        Ok(if same.is_empty() && !limits {
+            all
+        } else {
+            same
+        })
+    };
+    let inside = solutions(true)?;
+    let free = solutions(false)?;
+    let nearest = |s: &[RotarySolution]| {
+        s.iter().copied().min_by(|a, b| {
+            distance(a.rotary_deg, previous)
+                .total_cmp(&distance(b.rotary_deg, previous))
+                .then(a.branch.cmp(&b.branch))
+        })
+    };
+    let best_free = nearest(&free).expect("an unlimited solution exists");
+    match nearest(&inside) {
+        Some(b)
+            if distance(b.rotary_deg, previous)
+                <= distance(best_free.rotary_deg, previous) + JUMP_TOL_DEG =>
+        {
+            Ok(b)
+        }
+        forced => {
+            let jump = forced
+                .map(|b| {
+                    format!(
+                        "; the limits leave only a swing of {:.3}° in the rotaries",
+                        distance(b.rotary_deg, previous)
+                    )
+                })
+                .unwrap_or_default();
+            Err(Error::Machine {
+                location: format!("move {i}"),
+                message: format!(
+                    "going on continuously from move {} to tool axis {} needs {} on machine `{}` ({}){jump}; \
+                     widen the limits or plan with a different tool axis there",
+                    i.saturating_sub(1),
+                    axis_text(axis),
+                    outside_text(machine, &best_free),
+                    machine.name,
+                    limits_text(machine)
+                ),
+            })
+        }
+    }
+}
+
+/// Follows one chain from the rotary solution `seed` at `start`, continuously.
 fn follow(
     machine: &Machine,
     poses: &[PoseRequest],
     start: usize,
     end: usize,
-    seed: [f64; 2],
-) -> Result<Vec<Joints>> {
+    seed: &RotarySolution,
+) -> Result<Vec<Solved>> {
     let mut out = Vec::with_capacity(end - start);
-    let mut previous = seed;
+    let mut previous = *seed;
     for (i, p) in poses.iter().enumerate().take(end).skip(start) {
-        let rotary_deg = if i == start {
-            seed
+        let s = if i == start {
+            *seed
         } else {
-            let inside = machine
-                .rotary_solutions(&p.axis, previous, true)
-                .map_err(|Unreachable| unreachable(machine, i, &p.axis))?;
-            let free = machine
-                .rotary_solutions(&p.axis, previous, false)
-                .map_err(|Unreachable| unreachable(machine, i, &p.axis))?;
-            let nearest = |s: &[RotarySolution]| {
-                s.iter().copied().min_by(|a, b| {
-                    distance(a.rotary_deg, previous)
-                        .total_cmp(&distance(b.rotary_deg, previous))
-                        .then(a.branch.cmp(&b.branch))
-                })
-            };
-            let best_free = nearest(&free).expect("an unlimited solution exists");
-            match nearest(&inside) {
-                Some(b)
-                    if distance(b.rotary_deg, previous)
-                        <= distance(best_free.rotary_deg, previous) + JUMP_TOL_DEG =>
-                {
-                    b.rotary_deg
-                }
-                forced => {
-                    let jump = forced
-                        .map(|b| {
-                            format!(
-                                "; the limits leave only a swing of {:.3}° in the rotaries",
-                                distance(b.rotary_deg, previous)
-                            )
-                        })
-                        .unwrap_or_default();
-                    return Err(Error::Machine {
-                        location: format!("move {i}"),
-                        message: format!(
-                            "going on continuously from move {} to tool axis {} needs {} on machine `{}` ({}){jump}; \
-                             widen the limits or plan with a different tool axis there",
-                            i - 1,
-                            axis_text(&p.axis),
-                            outside_text(machine, &best_free),
-                            machine.name,
-                            limits_text(machine)
-                        ),
-                    });
-                }
-            }
+            continue_to(
+                machine,
+                &p.axis,
+                &poses[i - 1].axis,
+                previous.rotary_deg,
+                branch_of(&previous),
+                i,
+            )?
         };
-        let xyz_mm = machine.linear_joints(&p.tip, rotary_deg);
+        let xyz_mm = machine.linear_joints(&p.tip, s.rotary_deg);
         machine.check_linear(&xyz_mm, &format!("move {i}"))?;
-        out.push(Joints { xyz_mm, rotary_deg });
-        previous = rotary_deg;
+        out.push(Solved {
+            joints: Joints {
+                xyz_mm,
+                rotary_deg: s.rotary_deg,
+            },
+            branch: branch_of(&s),
+        });
+        previous = s;
     }
     Ok(out)
+}
+
+/// Most halvings of one move when linearising joint-space motion (2¹² pieces).
+const MAX_LINEARIZE_DEPTH: usize = 12;
+
+/// Fractions of a move where the joint-interpolated ball centre is compared with the chord.
+const LINEARIZE_SAMPLES: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// One end of a move for [`linearize`]: ball centre, tool axis, joint values and branch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Waypoint {
+    pub cl_point: Point3,
+    pub axis: Vector3,
+    pub joints: Joints,
+    pub branch: Option<u8>,
+}
+
+/// Unit vector a fraction `t` of the way from `a` to `b` along the great circle.
+pub fn slerp(a: &Vector3, b: &Vector3, t: f64) -> Vector3 {
+    let theta = a.angle(b);
+    if theta < super::kinematics::SINGULAR_CONE_RAD {
+        return (a + (b - a) * t).normalize();
+    }
+    ((a * ((1.0 - t) * theta).sin() + b * (t * theta).sin()) / theta.sin()).normalize()
+}
+
+/// Joint values a fraction `t` of the way from `a` to `b` (what a controller interpolating
+/// joints commands).
+fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
+    Joints {
+        xyz_mm: [0, 1, 2].map(|k| a.xyz_mm[k] + (b.xyz_mm[k] - a.xyz_mm[k]) * t),
+        rotary_deg: [0, 1].map(|k| a.rotary_deg[k] + (b.rotary_deg[k] - a.rotary_deg[k]) * t),
+    }
+}
+
+/// Poses to insert between `a` and `b` (move `i`) so that a controller interpolating the
+/// joints linearly keeps the ball centre within `tol_mm` of the straight chord the planner
+/// meant: the move is halved (ball centre on the chord, tool axis along the great circle)
+/// until every piece is within the tolerance. Empty when the move already is.
+pub fn linearize(
+    machine: &Machine,
+    tool_radius_mm: f64,
+    a: &Waypoint,
+    b: &Waypoint,
+    tol_mm: f64,
+    i: usize,
+) -> Result<Vec<Waypoint>> {
+    let mut out = Vec::new();
+    split(machine, tool_radius_mm, a, b, tol_mm, i, 0, &mut out)?;
+    Ok(out)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn split(
+    machine: &Machine,
+    r: f64,
+    a: &Waypoint,
+    b: &Waypoint,
+    tol: f64,
+    i: usize,
+    depth: usize,
+    out: &mut Vec<Waypoint>,
+) -> Result<()> {
+    let deviation = LINEARIZE_SAMPLES
+        .iter()
+        .map(|&t| {
+            let pose = machine.forward(&lerp_joints(&a.joints, &b.joints, t));
+            let centre = pose.tip + pose.axis * r;
+            (centre - (a.cl_point + (b.cl_point - a.cl_point) * t)).norm()
+        })
+        .fold(0.0, f64::max);
+    if deviation <= tol {
+        return Ok(());
+    }
+    if depth == MAX_LINEARIZE_DEPTH {
+        return Err(Error::Machine {
+            location: format!("move {i}"),
+            message: format!(
+                "the machine's joint motion leaves the straight path by {deviation:.4} mm even in \
+                 pieces of 1/{} of the move (tolerance {tol} mm)",
+                1usize << MAX_LINEARIZE_DEPTH
+            ),
+        });
+    }
+    let cl_point = a.cl_point + (b.cl_point - a.cl_point) * 0.5;
+    let axis = slerp(&a.axis, &b.axis, 0.5);
+    let s = continue_to(machine, &axis, &a.axis, a.joints.rotary_deg, a.branch, i)?;
+    let xyz_mm = machine.linear_joints(&(cl_point - axis * r), s.rotary_deg);
+    machine.check_linear(&xyz_mm, &format!("move {i}"))?;
+    let m = Waypoint {
+        cl_point,
+        axis,
+        joints: Joints {
+            xyz_mm,
+            rotary_deg: s.rotary_deg,
+        },
+        branch: branch_of(&s),
+    };
+    split(machine, r, a, &m, tol, i, depth + 1, out)?;
+    out.push(m);
+    split(machine, r, &m, b, tol, i, depth + 1, out)
 }

@@ -25,6 +25,9 @@ pub const SINGULAR_CONE_RAD: f64 = 1e-6;
 /// A tool axis whose inverse kinematics leaves this residual (rad) is not reachable.
 const ORIENTATION_RESIDUAL_RAD: f64 = 1e-9;
 
+/// A direction whose length differs from 1 by less than this is a unit vector.
+pub const UNIT_TOL: f64 = 1e-9;
+
 /// Two rotary axes closer to parallel than this (sine of the angle) cannot orient the tool.
 const MIN_AXIS_SINE: f64 = 1e-3;
 
@@ -212,7 +215,7 @@ impl Machine {
             if !matches!(r.name, 'A' | 'B' | 'C') {
                 return bad(loc("name"), format!("must be A, B or C, got {}", r.name));
             }
-            if !(r.axis.iter().all(|x| x.is_finite()) && (r.axis.norm() - 1.0).abs() < 1e-9) {
+            if !(r.axis.iter().all(|x| x.is_finite()) && (r.axis.norm() - 1.0).abs() < UNIT_TOL) {
                 return bad(
                     loc("axis"),
                     format!("must be a unit vector, got {:?}", r.axis.as_slice()),
@@ -313,6 +316,40 @@ impl Machine {
     /// pose (the rotary table of table-table and head-table machines).
     pub fn inner_rotary(&self) -> Option<usize> {
         (self.rotaries.len() == 2).then(|| self.form().inner)
+    }
+
+    /// The tool axis (workpiece frame) of the singular pose: along the inner rotary axis.
+    /// Its opposite is singular too.
+    pub fn singular_axis(&self) -> Option<Vector3> {
+        (self.rotaries.len() == 2).then(|| self.form().b2)
+    }
+
+    /// True when the great-circle arc of tool axes from `p` to `q` passes within
+    /// [`SINGULAR_CONE_RAD`] of the singular pose: only there may the rotary solution change
+    /// branch without a jump.
+    pub fn arc_meets_singular(&self, p: &Vector3, q: &Vector3) -> bool {
+        let Some(s) = self.singular_axis() else {
+            return false;
+        };
+        let (p, q) = (p.normalize(), q.normalize());
+        let n = p.cross(&q);
+        [s, -s].iter().any(|s| {
+            let ends = s.angle(&p).min(s.angle(&q));
+            let off_plane = if n.norm() > SINGULAR_CONE_RAD {
+                let n = n.normalize();
+                // The closest point of the great circle lies within the arc when it is on the
+                // inner side of both end points.
+                let foot = (s - n * n.dot(s)).normalize();
+                if p.cross(&foot).dot(&n) >= 0.0 && foot.cross(&q).dot(&n) >= 0.0 {
+                    n.dot(s).abs().asin()
+                } else {
+                    ends
+                }
+            } else {
+                ends
+            };
+            off_plane.min(ends) < SINGULAR_CONE_RAD
+        })
     }
 
     /// Tool axis in the workpiece frame for rotary angles (degrees).

@@ -33,6 +33,9 @@ pub const MM_PER_INCH: f64 = 25.4;
 /// A tool axis within this angle (rad) of +Z counts as +Z for 3-axis output.
 const THREE_AXIS_TOL_RAD: f64 = 1e-9;
 
+/// Planned tool axes must be unit vectors to this tolerance (planners normalise them).
+const TOOL_AXIS_UNIT_TOL: f64 = 1e-6;
+
 /// Decimals of lengths: 0.1 µm in mm programs, 0.254 µm in inch programs.
 const MM_DECIMALS: usize = 4;
 const INCH_DECIMALS: usize = 5;
@@ -196,13 +199,26 @@ pub enum OutputMode {
     ToolTip,
 }
 
+/// Where a motion block of a posted program comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// Path move `i`.
+    Move(usize),
+    /// A point on the chord from path move `i − 1` to move `i`, inserted so the machine's
+    /// joint interpolation stays within the chordal tolerance of it.
+    Inserted(usize),
+    /// The safe start or end.
+    Safe,
+}
+
 /// A posted program and how its motion blocks map back to the path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Posted {
     pub text: String,
-    /// For each motion block in program order: the index of the path move it is, or `None`
-    /// for a safe-start/end block the post added.
-    pub sources: Vec<Option<usize>>,
+    /// What each motion block in program order is.
+    pub sources: Vec<Source>,
+    /// Blocks inserted to keep joint-space motion on the planned chords.
+    pub inserted: usize,
     /// Joint values of every path move.
     pub joints: Vec<Joints>,
     pub mode: OutputMode,
@@ -268,7 +284,7 @@ struct Motion {
     /// Feed word value in program units (already converted), when written.
     feed: Option<f64>,
     extra: &'static str,
-    source: Option<usize>,
+    source: Source,
 }
 
 struct Out {
@@ -276,7 +292,7 @@ struct Out {
     units: Units,
     text: String,
     block: usize,
-    sources: Vec<Option<usize>>,
+    sources: Vec<Source>,
 }
 
 impl Out {
@@ -399,7 +415,7 @@ pub fn post_program(
     for (i, m) in path.moves.iter().enumerate() {
         let ok = m.cl_point.iter().all(|x| x.is_finite())
             && m.tool_axis.iter().all(|x| x.is_finite())
-            && (m.tool_axis.norm() - 1.0).abs() < 1e-6;
+            && (m.tool_axis.norm() - 1.0).abs() < TOOL_AXIS_UNIT_TOL;
         if !ok {
             return Err(Error::Machine {
                 location: format!("move {i}"),
@@ -407,7 +423,7 @@ pub fn post_program(
             });
         }
     }
-    let joints: Vec<Joints> = if mode == OutputMode::ThreeAxis {
+    let joints: Vec<joints::Solved> = if mode == OutputMode::ThreeAxis {
         let mut out = Vec::with_capacity(tips.len());
         for (i, (m, t)) in path.moves.iter().zip(&tips).enumerate() {
             if m.tool_axis.angle(&Vector3::z()) > THREE_AXIS_TOL_RAD {
@@ -431,9 +447,12 @@ pub fn post_program(
             }
             let xyz_mm = [t.x, t.y, t.z];
             machine.check_linear(&xyz_mm, &format!("move {i}"))?;
-            out.push(Joints {
-                xyz_mm,
-                rotary_deg: [0.0; 2],
+            out.push(joints::Solved {
+                joints: Joints {
+                    xyz_mm,
+                    rotary_deg: [0.0; 2],
+                },
+                branch: None,
             });
         }
         out
@@ -451,6 +470,8 @@ pub fn post_program(
             .collect();
         joints::solve(machine, &requests)?
     };
+    let branches: Vec<Option<u8>> = joints.iter().map(|s| s.branch).collect();
+    let joints: Vec<Joints> = joints.iter().map(|s| s.joints).collect();
 
     // Rotary words in address order (A, B, C).
     let mut rot_order: Vec<(char, usize)> = if mode == OutputMode::ThreeAxis {
@@ -469,12 +490,6 @@ pub fn post_program(
             .iter()
             .map(|&(n, i)| (n, j.rotary_deg[i]))
             .collect()
-    };
-    let position = |i: usize| -> [f64; 3] {
-        match mode {
-            OutputMode::Joints => joints[i].xyz_mm,
-            _ => [tips[i].x, tips[i].y, tips[i].z],
-        }
     };
 
     let syntax = dialect.syntax();
@@ -545,7 +560,7 @@ pub fn post_program(
         o.comment("feeds F in 0.1 inch/min");
     }
 
-    let safe_top = |source| Motion {
+    let safe_top = || Motion {
         rapid: true,
         machine_frame: true,
         xyz: [None, None, Some(machine.safe_z_machine_mm)],
@@ -553,13 +568,13 @@ pub fn post_program(
         feed_mode: None,
         feed: None,
         extra: "",
-        source,
+        source: Source::Safe,
     };
     match syntax {
         Syntax::Iso => {
             let g = if units == Units::Mm { "G21" } else { "G20" };
             o.line(&format!("{g} G90 G17 G94 G40 G49 G80"));
-            o.motion(&safe_top(None));
+            o.motion(&safe_top());
             o.line("T1 M6");
             if !(dialect == Dialect::Fanuc && mode == OutputMode::ToolTip) {
                 o.line("G43 H1");
@@ -569,13 +584,13 @@ pub fn post_program(
         Syntax::Siemens => {
             let g = if units == Units::Mm { "G710" } else { "G700" };
             o.line(&format!("{g} G90 G17 G94 G40"));
-            o.motion(&safe_top(None));
+            o.motion(&safe_top());
             o.line("T1 M6");
             o.line("D1");
             o.line(&format!("S{} M3", feed_text(opts.spindle_rpm)));
         }
         Syntax::Heidenhain => {
-            o.motion(&safe_top(None));
+            o.motion(&safe_top());
             o.line(&format!("TOOL CALL 1 Z S{}", feed_text(opts.spindle_rpm)));
         }
     }
@@ -589,7 +604,7 @@ pub fn post_program(
             feed_mode: None,
             feed: None,
             extra: "",
-            source: None,
+            source: Source::Safe,
         });
     }
     if mode == OutputMode::ToolTip {
@@ -601,7 +616,49 @@ pub fn post_program(
         }
     }
 
-    // The path.
+    // The path, with the points joint-space motion needs to stay on the planned chords.
+    struct Emit {
+        i: usize,
+        inserted: bool,
+        tip: Point3,
+        joints: Joints,
+    }
+    let mut emits: Vec<Emit> = Vec::with_capacity(path.moves.len());
+    for (i, m) in path.moves.iter().enumerate() {
+        let cutting = !matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+        if mode == OutputMode::Joints && cutting && i > 0 {
+            let prev = &path.moves[i - 1];
+            let way = |m: &crate::plan::Move, k: usize| joints::Waypoint {
+                cl_point: m.cl_point,
+                axis: m.tool_axis,
+                joints: joints[k],
+                branch: branches[k],
+            };
+            let extra = joints::linearize(
+                machine,
+                r,
+                &way(prev, i - 1),
+                &way(m, i),
+                opts.chordal_mm,
+                i,
+            )?;
+            for w in extra {
+                emits.push(Emit {
+                    i,
+                    inserted: true,
+                    tip: w.cl_point - w.axis * r,
+                    joints: w.joints,
+                });
+            }
+        }
+        emits.push(Emit {
+            i,
+            inserted: false,
+            tip: tips[i],
+            joints: joints[i],
+        });
+    }
+    let inserted = emits.iter().filter(|e| e.inserted).count();
     let inverse_time_ok = mode == OutputMode::Joints;
     let mut inverse_time = false;
     let mut feed_written: Option<String> = None;
@@ -609,15 +666,20 @@ pub fn post_program(
     let mut last_tip: Option<Point3> = None;
     let mut last_rot: Option<[f64; 2]> = joints.first().map(|j| j.rotary_deg);
     let mut spindle_extra = syntax == Syntax::Heidenhain;
-    for (i, m) in path.moves.iter().enumerate() {
+    for e in &emits {
+        let m = &path.moves[e.i];
         let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
-        let rotary = rot_words(&joints[i]);
+        let rotary = rot_words(&e.joints);
         let rot_text: Vec<String> = rotary.iter().map(|(_, v)| o.deg(*v)).collect();
         let rot_moves = rot_text != last_rot_text;
+        let xyz = match mode {
+            OutputMode::Joints => e.joints.xyz_mm,
+            _ => [e.tip.x, e.tip.y, e.tip.z],
+        };
         let mut motion = Motion {
             rapid,
             machine_frame: false,
-            xyz: position(i).map(Some),
+            xyz: xyz.map(Some),
             rotary,
             feed_mode: None,
             feed: None,
@@ -626,7 +688,11 @@ pub fn post_program(
             } else {
                 ""
             },
-            source: Some(i),
+            source: if e.inserted {
+                Source::Inserted(e.i)
+            } else {
+                Source::Move(e.i)
+            },
         };
         if !rapid {
             let feed_mm_min = if m.kind == MoveKind::Plunge {
@@ -634,11 +700,11 @@ pub fn post_program(
             } else {
                 opts.feed_mm_min
             };
-            let len = last_tip.map(|p| (tips[i] - p).norm()).unwrap_or(0.0);
+            let len = last_tip.map(|p| (e.tip - p).norm()).unwrap_or(0.0);
             let turn = last_rot
                 .map(|p| {
                     (0..2)
-                        .map(|k| (joints[i].rotary_deg[k] - p[k]).abs())
+                        .map(|k| (e.joints.rotary_deg[k] - p[k]).abs())
                         .fold(0.0, f64::max)
                 })
                 .unwrap_or(0.0);
@@ -670,8 +736,8 @@ pub fn post_program(
         }
         o.motion(&motion);
         last_rot_text = rot_text;
-        last_tip = Some(tips[i]);
-        last_rot = Some(joints[i].rotary_deg);
+        last_tip = Some(e.tip);
+        last_rot = Some(e.joints.rotary_deg);
     }
 
     // Safe end: retract along the tool axis to the clearance height.
@@ -701,7 +767,7 @@ pub fn post_program(
                 feed_mode: None,
                 feed: None,
                 extra: "",
-                source: None,
+                source: Source::Safe,
             });
         }
     }
@@ -721,7 +787,7 @@ pub fn post_program(
             if dialect != Dialect::Fanuc || mode != OutputMode::ToolTip {
                 o.line("G49");
             }
-            o.motion(&safe_top(None));
+            o.motion(&safe_top());
             o.line("M5");
             o.line(if dialect == Dialect::Fanuc {
                 "M30"
@@ -731,12 +797,12 @@ pub fn post_program(
             o.line("%");
         }
         Syntax::Siemens => {
-            o.motion(&safe_top(None));
+            o.motion(&safe_top());
             o.line("M5");
             o.line("M30");
         }
         Syntax::Heidenhain => {
-            let mut m = safe_top(None);
+            let mut m = safe_top();
             m.extra = "M30";
             o.motion(&m);
             o.line(&format!("END PGM {pname} {unit_word}"));
@@ -745,6 +811,7 @@ pub fn post_program(
     Ok(Posted {
         text: o.text,
         sources: o.sources,
+        inserted,
         joints,
         mode,
     })

@@ -4,8 +4,9 @@
 //! Owns: interpreting read moves as tool poses for a machine and dialect, and the comparison.
 //! Must not: write programs (it calls [`super::post`]).
 
+use super::joints::slerp;
 use super::kinematics::{Joints, Kinematics, Machine, ToolPose};
-use super::post::{self, Dialect, Posted, Units};
+use super::post::{self, Dialect, Posted, Source, Units};
 use super::reader::{self, FeedMode, Program, ProgramMove};
 use super::JobInfo;
 use crate::error::{Error, Result};
@@ -26,6 +27,9 @@ pub struct RoundTrip {
     pub moves_compared: usize,
     /// Blocks the post added for the safe start and end.
     pub safe_blocks: usize,
+    /// Blocks the post inserted on planned chords (joint-value output); they are compared with
+    /// the chord (ball centre) and the great-circle blend of the axes at the same fraction.
+    pub inserted_blocks: usize,
     /// Largest distance between a read-back ball centre and the planned one (mm).
     pub max_position_error_mm: f64,
     pub worst_position_move: usize,
@@ -121,6 +125,7 @@ pub fn compare(
         units: program.units.name().into(),
         moves_compared: 0,
         safe_blocks: 0,
+        inserted_blocks: 0,
         max_position_error_mm: 0.0,
         worst_position_move: 0,
         max_axis_error_deg: 0.0,
@@ -130,10 +135,17 @@ pub fn compare(
     let mut previous: Option<(ToolPose, [f64; 3])> = None;
     for (k, src) in posted.sources.iter().enumerate() {
         let read = &program.moves[k];
-        let Some(i) = *src else {
-            out.safe_blocks += 1;
-            previous = poses[k].map(|p| (p, read.abc_deg));
-            continue;
+        let (i, inserted) = match *src {
+            Source::Safe => {
+                out.safe_blocks += 1;
+                previous = poses[k].map(|p| (p, read.abc_deg));
+                continue;
+            }
+            Source::Move(i) => (i, false),
+            Source::Inserted(i) if i > 0 => (i, true),
+            Source::Inserted(_) => {
+                return Err(mismatch("a block is inserted before the first move".into()))
+            }
         };
         let planned = &path.moves[i];
         let pose = poses[k].ok_or_else(|| {
@@ -143,8 +155,27 @@ pub fn compare(
             ))
         })?;
         let centre = pose.tip + pose.axis * r;
-        let e_pos = (centre - planned.cl_point).norm();
-        let e_ax = pose.axis.angle(&planned.tool_axis).to_degrees();
+        let (e_pos, e_ax) = if inserted {
+            // On the chord from the previous move, at the fraction it is along it.
+            let a = &path.moves[i - 1];
+            let ab = planned.cl_point - a.cl_point;
+            let t = if ab.norm_squared() > 0.0 {
+                ((centre - a.cl_point).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+            } else {
+                0.5
+            };
+            let expect_axis = slerp(&a.tool_axis, &planned.tool_axis, t);
+            out.inserted_blocks += 1;
+            (
+                (centre - (a.cl_point + ab * t)).norm(),
+                pose.axis.angle(&expect_axis).to_degrees(),
+            )
+        } else {
+            (
+                (centre - planned.cl_point).norm(),
+                pose.axis.angle(&planned.tool_axis).to_degrees(),
+            )
+        };
         if !(e_pos <= out.max_position_error_mm) {
             out.max_position_error_mm = e_pos;
             out.worst_position_move = i;
@@ -153,7 +184,9 @@ pub fn compare(
             out.max_axis_error_deg = e_ax;
             out.worst_axis_move = i;
         }
-        out.moves_compared += 1;
+        if !inserted {
+            out.moves_compared += 1;
+        }
         let planned_feed = match planned.kind {
             MoveKind::Plunge => opts.plunge_feed_mm_min,
             _ => opts.feed_mm_min,
