@@ -5,14 +5,19 @@
 //! path or format output.
 //!
 //! Rules. Moves between two rapids form a *chain* the tool cuts without leaving the part;
-//! inside a chain every move takes the solution nearest (in joint space) to the previous
-//! one, so no rotary jumps. At the singular pose (tool axis along the inner rotary) the
-//! inner angle keeps its previous value. When the nearest solution is outside a limit, the
-//! chain must not fall back on a far one (a 180° or 360° swing while cutting): that is an
-//! error naming the move. At the first move of a chain (a rapid, above the part) the rotaries
-//! may take any solution: the one nearest the previous pose for which the whole chain stays
-//! within limits is chosen, which is how endless-looking rotaries are unwound within their
-//! travel.
+//! inside a chain every move keeps the orientation branch of the previous one (the sign of the
+//! tilt) and takes its nearest turn, so no rotary jumps; the branch may change only where the
+//! arc of tool axes between two moves meets the singular pose (tool axis along the inner
+//! rotary), and there the inner angle keeps its previous value. When the continuous solution
+//! is outside a limit, the chain must not fall back on a far one (a 180° or 360° swing while
+//! cutting): that is an error naming the move. At the first move of a chain (a rapid, above
+//! the part) the rotaries may take any solution: the one nearest the previous pose for which
+//! the whole chain stays within limits is chosen, which is how rotaries are unwound within
+//! their travel.
+//!
+//! A controller that interpolates joint values moves the ball centre off the straight chord
+//! where the rotaries turn fast; [`linearize`] splits such moves until it stays within the
+//! chordal tolerance.
 
 use super::kinematics::{Joints, Machine, RotarySolution, Unreachable};
 use crate::error::{Error, Result};

@@ -3,10 +3,10 @@
 //!
 //! Owns: machine models and their kinematics ([`kinematics`]), machine definitions as JSON
 //! and the built-in machines ([`definition`]), joint values along a path ([`joints`]),
-//! controller dialects ([`post`]), the program reader ([`reader`]) and the round-trip check
+//! controller dialects ([`mod@post`]), the program reader ([`reader`]) and the round-trip check
 //! ([`roundtrip`]). Must not: plan or change the path.
 //!
-//! The one entry point the rest of the crate uses is [`post`].
+//! The one entry point the rest of the crate uses is [`post()`].
 
 pub mod definition;
 pub mod joints;
@@ -46,7 +46,7 @@ pub fn post(
 }
 
 /// Three-axis G-code in millimetres for a LinuxCNC / Fanuc compatible controller: positions
-/// are the tool tip (ball centre minus the radius along the axis). Same as [`post`] with the
+/// are the tool tip (ball centre minus the radius along the axis). Same as [`post()`] with the
 /// `3-axis` machine, the `plain` dialect and mm; errors when a tool axis is not +Z.
 pub fn gcode_3axis(path: &Toolpath, opts: &PlanOptions, job: &JobInfo) -> Result<String> {
     let machine = builtin("3-axis")?;

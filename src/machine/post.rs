@@ -8,7 +8,9 @@
 //! and the tool axis must be +Z. In the `linuxcnc` dialect on a 5-axis machine, X Y Z and the
 //! rotaries are *machine joint values* from the inverse kinematics (a LinuxCNC with trivial
 //! kinematics, or trt kinematics in identity mode), and moves that turn a rotary use
-//! inverse-time feed (G93, F = 1/minutes) so the tool tip keeps the programmed feed. The
+//! inverse-time feed (G93, F = 1/minutes) so the tool tip keeps the programmed feed; moves
+//! whose joint interpolation would leave the planned chord by more than `chordal_mm` are split
+//! (see [`super::joints::linearize`]). The
 //! tool-centre-point dialects (`linuxcnc-tcp`, `fanuc` G43.4, `heidenhain` FUNCTION TCPM,
 //! `siemens` TRAORI) write the *tool tip* in the workpiece frame plus the rotary angles;
 //! the controller moves the linear axes and keeps the programmed feed at the tip (G94).
@@ -380,7 +382,7 @@ impl Out {
     }
 }
 
-/// Posts `path` for `machine` in `dialect` and `units`; see [`super::post`].
+/// Posts `path` for `machine` in `dialect` and `units`; see [`super::post()`].
 pub fn post_program(
     path: &Toolpath,
     opts: &PlanOptions,

@@ -2,7 +2,7 @@
 //! the planned ball centres and tool axes (and feeds).
 //!
 //! Owns: interpreting read moves as tool poses for a machine and dialect, and the comparison.
-//! Must not: write programs (it calls [`super::post`]).
+//! Must not: write programs (it calls [`super::post::post_program`]).
 
 use super::joints::slerp;
 use super::kinematics::{Joints, Kinematics, Machine, ToolPose};
