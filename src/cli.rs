@@ -2,7 +2,7 @@
 //! the page uses. Returns the text to print so that tests can run it in-process.
 
 use crate::error::{Error, Result};
-use crate::machine::{self, JobInfo};
+use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions};
 use std::time::Instant;
@@ -13,8 +13,14 @@ const USAGE: &str = "usage:
   tspath sample NAME -o FILE.json
   tspath export MODEL -o FILE.stl|FILE.obj [--chordal MM]
   tspath plan MODEL [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
+              [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [-o OUT.nc] [--report REPORT.json]
+  tspath machine --list
+  tspath machine NAME [-o FILE.json]
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
+--machine is a built-in machine (default 3-axis) or a machine JSON file (start from
+`tspath machine NAME -o FILE.json`); --dialect is linuxcnc (default), linuxcnc-tcp, fanuc,
+heidenhain, siemens or plain; --units mm (default) or inch.
 ";
 
 /// Runs one command; returns what it prints on success.
@@ -28,6 +34,7 @@ pub fn run(args: &[String]) -> Result<String> {
         "sample" => sample(rest),
         "plan" => plan(rest),
         "export" => export(rest),
+        "machine" => machine_cmd(rest),
         "-h" | "--help" | "help" => Ok(USAGE.into()),
         other => Err(Error::Io(format!("unknown command `{other}`\n{USAGE}"))),
     }
@@ -187,6 +194,9 @@ fn plan(args: &[String]) -> Result<String> {
             "--feed",
             "-o",
             "--report",
+            "--machine",
+            "--dialect",
+            "--units",
         ],
         &[],
     )?;
@@ -194,6 +204,9 @@ fn plan(args: &[String]) -> Result<String> {
         return Err(Error::Io(format!("plan takes one MODEL\n{USAGE}")));
     };
     let m = load_model(model)?;
+    let mach = load_machine(a.value("--machine").unwrap_or("3-axis"))?;
+    let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
+    let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
     let mut opts = PlanOptions::default();
     if let Some(v) = a.number("--tool-radius")? {
         opts.tool_radius_mm = v;
@@ -211,14 +224,17 @@ fn plan(args: &[String]) -> Result<String> {
     let path = isoparametric::plan_zigzag(&m, &opts, &mut |_| true)?;
     let mut report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let gcode = machine::gcode_3axis(
+    let gcode = machine::post(
         &path,
         &opts,
         &JobInfo {
             model: m.name.clone(),
             strategy: "isoparametric".into(),
         },
-    );
+        &mach,
+        dialect,
+        units,
+    )?;
     let report_json = serde_json::to_string_pretty(&report).expect("report serialises") + "\n";
     let mut out = String::new();
     match a.value("-o") {
@@ -231,4 +247,44 @@ fn plan(args: &[String]) -> Result<String> {
         None => {}
     }
     Ok(out)
+}
+
+/// A built-in machine by name, or a machine JSON file.
+pub fn load_machine(arg: &str) -> Result<machine::Machine> {
+    let path = std::path::Path::new(arg);
+    if machine::MACHINES.iter().any(|m| m.name == arg) {
+        machine::builtin(arg)
+    } else if path.exists() {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Io(format!("cannot read {arg}: {e}")))?;
+        machine::from_json(&text).map_err(|e| Error::Io(format!("{arg}: {e}")))
+    } else {
+        machine::builtin(arg)
+    }
+}
+
+fn machine_cmd(args: &[String]) -> Result<String> {
+    let a = parse(args, &["-o"], &["--list"])?;
+    if a.has("--list") {
+        let mut s = String::from("machines:\n");
+        for m in machine::MACHINES {
+            s.push_str(&format!("  {:<16} {}\n", m.name, m.description));
+        }
+        s.push_str("dialects:\n");
+        for (_, name, what) in machine::DIALECTS {
+            s.push_str(&format!("  {name:<16} {what}\n"));
+        }
+        return Ok(s);
+    }
+    let [name] = a.positional[..] else {
+        return Err(Error::Io(format!("machine takes one NAME\n{USAGE}")));
+    };
+    let json = machine::to_json(&machine::builtin(name)?);
+    match a.value("-o") {
+        Some(path) => {
+            write_file(path, &json)?;
+            Ok(String::new())
+        }
+        None => Ok(json),
+    }
 }

@@ -103,3 +103,25 @@ fn impossible_parameters_throw() {
     assert!(msg.contains("scallop_mm"), "{msg}");
     assert!(js_message(model.tessellate(0.0).err().unwrap()).contains("chordal"));
 }
+
+#[wasm_bindgen_test]
+fn machine_dialect_and_units_choice() {
+    use tspath::wasm::{dialect_names, machine_json, machine_names};
+    assert!(machine_names().iter().any(|n| n == "table-table-ac"));
+    assert!(dialect_names().iter().any(|n| n == "heidenhain"));
+    let model = Model::sample("dome").unwrap();
+    let plan = model.plan(JsValue::UNDEFINED, None).unwrap();
+    let default = plan.gcode();
+    let fanuc = plan.gcode_for("table-table-ac", "fanuc", "inch").unwrap();
+    assert!(fanuc.contains("G20") && fanuc.contains("G43.4 H1") && fanuc.contains("(model: dome)"));
+    // A machine given as JSON text gives the same program as by name.
+    let json = machine_json("table-table-ac").unwrap();
+    assert_eq!(plan.gcode_for(&json, "fanuc", "inch").unwrap(), fanuc);
+    assert_eq!(plan.gcode_for("3-axis", "plain", "mm").unwrap(), default);
+    let msg = js_message(
+        plan.gcode_for("table-table-ac", "klingon", "mm")
+            .err()
+            .unwrap(),
+    );
+    assert!(msg.contains("klingon") && msg.contains("linuxcnc"), "{msg}");
+}

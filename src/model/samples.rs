@@ -40,14 +40,14 @@ pub const SAMPLES: &[SampleInfo] = &[
     },
     SampleInfo {
         name: "keycap-convex",
-        description: "convex half of a keycap mould (Shang et al. 2020): an open box with drafted walls and a dished top, Catmull–Clark, 5 patches, 4 extraordinary points at the top corners",
+        description: "convex half of a keycap mould (Shang et al. 2020): drafted walls, a dished top and a flat flange (parting surface) at the base, Catmull–Clark, 5 patches, 4 extraordinary points at the top corners",
         patches: 5,
         extraordinary_points: 4,
         size_mm: [14.4, 14.4, 6.8],
     },
     SampleInfo {
         name: "keycap-concave",
-        description: "concave half of a keycap mould: a drafted cavity with a domed floor, normals into the cavity, Catmull–Clark, 5 patches, 4 extraordinary points at the floor corners",
+        description: "concave half of a keycap mould: a drafted cavity with a domed floor and a flat flange (parting surface) around its rim, normals into the cavity, Catmull–Clark, 5 patches, 4 extraordinary points at the floor corners",
         patches: 5,
         extraordinary_points: 4,
         size_mm: [18.0, 18.0, 8.6],
@@ -247,8 +247,38 @@ fn cube_cage(n: usize, open: Open, inward: bool) -> (Vec<[f64; 3]>, Vec<FaceLoop
             }
         }
     }
+    if open != Open::None {
+        // A flat flange around the opening (the mould's parting surface), so the walls meet
+        // the boundary upright instead of curling under it.
+        let directed: std::collections::HashSet<(u32, u32)> = faces
+            .iter()
+            .flat_map(|f| (0..4).map(move |k| (f.vertices[k], f.vertices[(k + 1) % 4])))
+            .collect();
+        let mut outer: HashMap<u32, u32> = HashMap::new();
+        let mut ring = Vec::new();
+        for &(a, b) in &directed {
+            if !directed.contains(&(b, a)) {
+                ring.push((a, b));
+            }
+        }
+        ring.sort_unstable();
+        for (a, b) in ring {
+            let mut off = |v: u32, pts: &mut Vec<[f64; 3]>| {
+                *outer.entry(v).or_insert_with(|| {
+                    let p = pts[v as usize];
+                    pts.push([p[0] * FLANGE, p[1] * FLANGE, p[2]]);
+                    (pts.len() - 1) as u32
+                })
+            };
+            let (a2, b2) = (off(a, &mut pts), off(b, &mut pts));
+            faces.push(FaceLoop::quad(b, a, a2, b2));
+        }
+    }
     (pts, faces)
 }
+
+/// How far the flange reaches beyond the opening, as a factor on the cube's half-width.
+const FLANGE: f64 = 1.35;
 
 /// Builds a Catmull–Clark mesh from a cube cage mapped by `shape`, then scales and moves it
 /// so its limit surface spans `size` with its lowest point at z = 0, centred on x = y = 0.

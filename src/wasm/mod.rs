@@ -6,7 +6,7 @@
 //! JavaScript as a thrown `Error` whose message says what to fix.
 
 use crate::error::Error;
-use crate::machine::{self, JobInfo};
+use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions, PlanReport, Toolpath};
 use crate::surface::tessellate::Tessellation;
@@ -35,6 +35,32 @@ pub fn sample_names() -> Vec<String> {
         .iter()
         .map(|s| s.name.to_string())
         .collect()
+}
+
+/// Names of the built-in machines (`3-axis`, `table-table-ac`, ...).
+#[wasm_bindgen(js_name = machineNames)]
+pub fn machine_names() -> Vec<String> {
+    machine::MACHINES
+        .iter()
+        .map(|m| m.name.to_string())
+        .collect()
+}
+
+/// Names of the G-code dialects (`linuxcnc`, `fanuc`, ...).
+#[wasm_bindgen(js_name = dialectNames)]
+pub fn dialect_names() -> Vec<String> {
+    machine::DIALECTS
+        .iter()
+        .map(|(_, n, _)| n.to_string())
+        .collect()
+}
+
+/// A built-in machine as the JSON text users edit (see the README's "Machines").
+#[wasm_bindgen(js_name = machineJson)]
+pub fn machine_json(name: &str) -> Result<String, JsError> {
+    machine::builtin(name)
+        .map(|m| machine::to_json(&m))
+        .map_err(js_err)
 }
 
 /// The crate version, for page footers and G-code headers.
@@ -121,18 +147,17 @@ impl WasmModel {
         let path = isoparametric::plan_zigzag(&self.model, &opts, &mut cb).map_err(js_err)?;
         let mut report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
         report.plan_ms = now_ms() - t0;
-        let gcode = machine::gcode_3axis(
-            &path,
-            &opts,
-            &JobInfo {
-                model: self.model.name.clone(),
-                strategy: "isoparametric".into(),
-            },
-        );
+        let job = JobInfo {
+            model: self.model.name.clone(),
+            strategy: "isoparametric".into(),
+        };
+        let gcode = machine::gcode_3axis(&path, &opts, &job).map_err(js_err)?;
         Ok(WasmPlan {
             path,
             report,
             gcode,
+            opts,
+            job,
         })
     }
 }
@@ -170,6 +195,8 @@ pub struct WasmPlan {
     path: Toolpath,
     report: PlanReport,
     gcode: String,
+    opts: PlanOptions,
+    job: JobInfo,
 }
 
 #[wasm_bindgen(js_class = Plan)]
@@ -222,8 +249,20 @@ impl WasmPlan {
     pub fn report(&self) -> Result<JsValue, JsError> {
         serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))
     }
-    /// The G-code program (mm).
+    /// The G-code program (3-axis, plain dialect, mm).
     pub fn gcode(&self) -> String {
         self.gcode.clone()
+    }
+
+    /// The program for a machine, dialect and units: `machine` is a built-in machine name
+    /// (see `machineNames()`) or the text of a machine JSON file; `dialect` one of
+    /// `dialectNames()`; `units` `mm` or `inch`. Throws with a message naming the move when
+    /// the machine cannot do the path.
+    #[wasm_bindgen(js_name = gcodeFor)]
+    pub fn gcode_for(&self, machine: &str, dialect: &str, units: &str) -> Result<String, JsError> {
+        let m = machine::resolve(machine).map_err(js_err)?;
+        let d = Dialect::parse(dialect).map_err(js_err)?;
+        let u = Units::parse(units).map_err(js_err)?;
+        machine::post(&self.path, &self.opts, &self.job, &m, d, u).map_err(js_err)
     }
 }
