@@ -1,10 +1,12 @@
 //! Readers and writers of model files. Readers turn bytes into a validated [`TMesh`]
 //! wrapped in a [`Model`]; they never evaluate the surface themselves.
 //!
-//! Formats: the project's JSON T-mesh ([`json`]). The format is detected from the content,
-//! not from a file name, so the page and the CLI accept the same bytes.
+//! Formats: the project's JSON T-mesh ([`json`]) and Autodesk T-Splines `.tsm` files
+//! ([`tsm`]). The format is detected from the content, not from a file name, so the page and
+//! the CLI accept the same bytes.
 
 pub mod json;
+pub mod tsm;
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -73,6 +75,10 @@ pub fn load(bytes: &[u8], name: &str) -> Result<Model> {
                 &meta.name
             };
             Model::try_new(name, "json", &meta.units, mesh)
+        }
+        Format::Tsm => {
+            let (mesh, meta) = tsm::read(bytes)?;
+            Model::try_new(name, "tsm", &meta.units_label(), mesh)
         }
         f => Err(Error::Unsupported(format!(
             "{} files are not readable by this build yet",
