@@ -26,8 +26,10 @@
 //!   N, W, S, E (counter-clockwise) a wedge listing the grips `a` steps along k and `b` steps
 //!   along the next direction, `a` in 1..=d_k then `b` in 0..=d_(k+1); -1 is a hole (the
 //!   outside quadrant of a concave corner). Blocks encode Bézier end conditions and creases.
+//! - `ec edge c`: an edge condition, `c` = 0 on boundary edges (kept in
+//!   [`TsmMeta::edge_conditions`]; creases themselves come from grip blocks).
 //! - `100001uv s t`: parameters of each vertex slot (kept for checking, see
-//!   [`TsmMeta::uv_records`]). Everything else (`ec`, `100001uvr`, `50000grip`, `105…`,
+//!   [`TsmMeta::uv_records`]). Everything else (`100001uvr`, `50000grip`, `105…`,
 //!   `odd-grip-map`, unknown records) is application data and skipped.
 //!
 //! # The T-mesh built from it
@@ -91,6 +93,8 @@ pub struct TsmMeta {
     pub uv_records: Vec<Option<[f64; 2]>>,
     /// For each T-mesh vertex, the `0g` record (grip number) it comes from.
     pub grip_of_vertex: Vec<u32>,
+    /// The `ec` records: file edge and its condition (0: boundary).
+    pub edge_conditions: Vec<(u32, i64)>,
     /// Records skipped as application data or unknown.
     pub skipped_records: usize,
 }
@@ -160,6 +164,7 @@ struct Parsed {
     owners: Vec<GripOwner>,
     blocks: Vec<RawBlock>,
     uv: Vec<Option<[f64; 2]>>,
+    edge_conditions: Vec<(u32, i64)>,
     skipped: usize,
     /// Raw indices as read, resolved once all records are known: (line, field, value, kind).
     pending: Vec<Pending>,
@@ -479,6 +484,15 @@ fn parse(bytes: &[u8]) -> Result<Parsed> {
                     Some(RawGrip { xyz, w })
                 };
                 p.grips.push(Slot { line, rec });
+            }
+            "ec" => {
+                if !empty {
+                    f.count(2, "edge and condition")?;
+                    let e = f.int(0, "the edge")?;
+                    let c = f.int(1, "the condition")?;
+                    p.pend(line, "its edge", e, Kind::Edge);
+                    p.edge_conditions.push((e.max(0) as u32, c));
+                }
             }
             "100001uv" => {
                 let rec = if empty {
@@ -890,6 +904,26 @@ fn check_topology(p: &Parsed) -> Result<Topology> {
             .position(|&l| p.link(l).flag == 0)
             .expect("four corners");
         lp.rotate_left(first);
+        // Opposite sides must span the same parameter length.
+        let mut sums = [0.0f64; 4];
+        let mut side = 0;
+        for (i, &l) in lp.iter().enumerate() {
+            if i > 0 && p.link(l).flag == 0 {
+                side += 1;
+            }
+            let e = p.link(l).edge;
+            sums[side] += p.edges[e].rec.map_or(0.0, |r| r.1);
+        }
+        let tol = KNOT_MATCH_REL * sums.iter().cloned().fold(1.0, f64::max);
+        if (sums[0] - sums[2]).abs() > tol || (sums[1] - sums[3]).abs() > tol {
+            return Err(perr(
+                slot.line,
+                format!(
+                    "face {f}: opposite sides have different knot interval sums ({} {} {} {})",
+                    sums[0], sums[1], sums[2], sums[3]
+                ),
+            ));
+        }
         loops[f] = lp;
     }
     Ok(Topology {
@@ -1395,6 +1429,7 @@ pub fn read(bytes: &[u8]) -> Result<(TMesh, TsmMeta)> {
             vertex_of_slot,
             uv_records,
             grip_of_vertex: placed.grip_of_vertex,
+            edge_conditions: p.edge_conditions.clone(),
             skipped_records: p.skipped,
         },
     ))
