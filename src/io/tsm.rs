@@ -166,7 +166,7 @@ struct Parsed {
     uv: Vec<Option<[f64; 2]>>,
     edge_conditions: Vec<(u32, i64)>,
     skipped: usize,
-    /// Raw indices as read, resolved once all records are known: (line, field, value, kind).
+    /// Index operands as read, checked once every record is known.
     pending: Vec<Pending>,
 }
 
