@@ -125,3 +125,23 @@ fn machine_dialect_and_units_choice() {
     );
     assert!(msg.contains("klingon") && msg.contains("linuxcnc"), "{msg}");
 }
+
+#[wasm_bindgen_test]
+fn tsm_bytes_load_through_the_same_loader() {
+    // A real T-Splines file, detected from its `#TS0200` tag.
+    let bytes = include_bytes!("../../shared/fixtures/tsm/simple.tsm");
+    let model = Model::from_bytes(bytes, "simple").unwrap();
+    let summary = model.summary().unwrap();
+    assert_eq!(get(&summary, "format").as_string().as_deref(), Some("tsm"));
+    assert_eq!(
+        get(&summary, "units_read").as_string().as_deref(),
+        Some("millimeters (0.001 m)")
+    );
+    assert_eq!(get(&summary, "patches").as_f64(), Some(3.0));
+    let broken = String::from_utf8_lossy(bytes).replace("e 0 0.5", "e 0 x");
+    let msg = js_message(Model::from_bytes(broken.as_bytes(), "x").err().unwrap());
+    assert!(
+        msg.contains("line ") && msg.contains("knot interval"),
+        "{msg}"
+    );
+}

@@ -138,14 +138,23 @@ impl TMesh {
                 break;
             }
         }
-        // Falls on the side's far corner only through rounding: take the last vertex.
+        // Falls on the side's far corner only through rounding: take the last vertex. An
+        // empty opposite side (a zero-area face's cusp) lands on the cusp, the origin of the
+        // next side, whose direction is a quarter turn further: the ray is two quarters on.
         let landing = landing.unwrap_or_else(|| {
-            let h = self
-                .face_half_edges(f)
-                .into_iter()
-                .rfind(|&h| self.he(h).side == opp)
-                .expect("every face has four sides");
-            At::Vertex { h_ref: h, theta: 3 }
+            let hs = self.face_half_edges(f);
+            match hs.iter().rfind(|&&h| self.he(h).side == opp) {
+                Some(&h) => At::Vertex { h_ref: h, theta: 3 },
+                None => {
+                    let next = (opp + 1) % 4;
+                    let h = hs
+                        .iter()
+                        .copied()
+                        .find(|&h| self.he(h).side == next)
+                        .unwrap_or(hs[0]);
+                    At::Vertex { h_ref: h, theta: 2 }
+                }
+            }
         });
         (across, landing)
     }
