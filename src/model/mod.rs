@@ -61,6 +61,40 @@ impl Model {
         crate::surface::tessellate::tessellate(&self.mesh, &self.surface, &self.layout, chordal_mm)
     }
 
+    /// Surface positions of the extraordinary points (mm), in vertex order.
+    pub fn extraordinary_positions(&self) -> Vec<crate::geom::Point3> {
+        let index: std::collections::HashMap<u32, usize> = self
+            .surface
+            .faces()
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.mesh_face, i))
+            .collect();
+        (0..self.mesh.vertex_count() as u32)
+            .filter(|&v| self.mesh.is_extraordinary(v))
+            .filter_map(|v| {
+                self.mesh.outgoing(v).into_iter().find_map(|h| {
+                    let e = self.mesh.he(h);
+                    let &fi = index.get(&e.face)?;
+                    let face = &self.mesh.faces()[e.face as usize];
+                    let s = e.offset
+                        / if e.side % 2 == 0 {
+                            face.width
+                        } else {
+                            face.height
+                        };
+                    let (u, v) = match e.side {
+                        0 => (s, 0.0),
+                        1 => (1.0, s),
+                        2 => (1.0 - s, 1.0),
+                        _ => (0.0, 1.0 - s),
+                    };
+                    Some(self.surface.subs(fi, u, v))
+                })
+            })
+            .collect()
+    }
+
     /// Counts and bounding box.
     pub fn summary(&self) -> ModelSummary {
         let nv = self.mesh.vertex_count();

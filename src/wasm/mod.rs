@@ -106,6 +106,44 @@ impl WasmModel {
             .map_err(|e| JsError::new(&e.to_string()))
     }
 
+    /// Positions of the extraordinary points on the surface, `x y z` each (mm).
+    #[wasm_bindgen(js_name = extraordinaryPoints)]
+    pub fn extraordinary_points(&self) -> js_sys::Float64Array {
+        let v: Vec<f64> = self
+            .model
+            .extraordinary_positions()
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.z])
+            .collect();
+        js_sys::Float64Array::from(&v[..])
+    }
+
+    /// Evaluates point and first and second derivatives on an `n × n` grid of every face and
+    /// returns the number of evaluations; a timing hook for the wasm benchmark script.
+    #[wasm_bindgen(js_name = benchDerivs)]
+    pub fn bench_derivs(&self, n: u32) -> f64 {
+        let mut count = 0.0;
+        let mut acc = 0.0;
+        let n = n.max(1) as usize;
+        for f in 0..self.model.surface.faces().len() {
+            for k in 0..n * n {
+                let (i, j) = (k % n, k / n);
+                let d = self.model.surface.derivs(
+                    f,
+                    (i as f64 + 0.37) / n as f64,
+                    (j as f64 + 0.61) / n as f64,
+                );
+                acc += d.point.x + d.suu.y + d.svv.z;
+                count += 1.0;
+            }
+        }
+        if acc.is_nan() {
+            -count
+        } else {
+            count
+        }
+    }
+
     /// Triangles of the surface within `chordal_mm` (mm) of it.
     pub fn tessellate(&self, chordal_mm: f64) -> Result<WasmMesh, JsError> {
         if !(chordal_mm.is_finite() && chordal_mm > 0.0) {
