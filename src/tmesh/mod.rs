@@ -18,6 +18,7 @@
 //! stack of repeated knot lines ends, fanning into one vertex (e.g. the repeated knots of a
 //! concave boundary corner with Bézier end conditions). It occupies no angle at the cusp.
 
+pub mod refine;
 pub mod walk;
 
 use crate::error::{Error, Result};
