@@ -338,6 +338,83 @@ fn rotaries_pass_near_the_singular_pose_with_the_smallest_motion() {
 }
 
 #[test]
+fn a_limit_met_later_decides_the_way_past_the_pole() {
+    // The tool axis tilts from 40° on one side of the pole to 40° on the other, missing the
+    // pole by 0.001° halfway between two moves. Flipping the tilt's sign there is the smaller
+    // step (a free trunnion does it), but on a trunnion that tilts one way only to 30° it
+    // would end at a tilt of 40° on the wrong side: the rotaries must keep the tilt's sign and
+    // turn C round the pole instead, decided before the limit is met.
+    let axes: Vec<Vector3> = (-40..40)
+        .map(|k| {
+            let t = (k as f64 + 0.5).to_radians();
+            Vector3::new(t.sin(), 1e-3f64.to_radians().sin(), t.cos()).normalize()
+        })
+        .collect();
+    let path = sweep(&axes, 3.0, 0.5, 10.0);
+    let trunnion = |limits: &str| {
+        machine::from_json(&format!(
+            r#"{{"format": "tspath-machine", "version": 1, "name": "one-way",
+            "rotaries": [
+              {{"name": "A", "mount": "table", "axis": [1, 0, 0], "pivot_mm": [0, 0, -80], "limits_deg": {limits}}},
+              {{"name": "C", "mount": "table", "axis": [0, 0, 1]}}
+            ]}}"#
+        ))
+        .unwrap()
+    };
+    let pass = 40; // move index of the first axis past the pole
+    let free = joints_of(&path, &trunnion("[-120, 120]")).unwrap();
+    assert!(
+        free[pass - 1].rotary_deg[0] * free[pass].rotary_deg[0] < 0.0,
+        "a free trunnion flips the tilt's sign: {:?} {:?}",
+        free[pass - 1],
+        free[pass]
+    );
+    let c_free = (free[pass].rotary_deg[1] - free[pass - 1].rotary_deg[1]).abs();
+    assert!(c_free < 1.0, "and turns C a little: {c_free}°");
+    for limits in ["[-120, 30]", "[-30, 120]"] {
+        let j = joints_of(&path, &trunnion(limits)).unwrap_or_else(|e| panic!("{limits}: {e}"));
+        let a: Vec<f64> = j.iter().map(|j| j.rotary_deg[0]).collect();
+        let sign = a[1].signum();
+        assert!(
+            a.iter()
+                .skip(1)
+                .all(|x| x * sign >= 0.0 && x.abs() <= 40.0 + 1e-9),
+            "{limits}: A keeps its sign: {a:?}"
+        );
+        let steps = rotary_steps(&path, &j);
+        let (_, c_pass, _) = steps[pass - 1];
+        assert!(
+            (c_pass - (180.0 - c_free)).abs() < 1e-6,
+            "{limits}: C turns round the pole by the azimuth change, {c_pass}°"
+        );
+        for (i, (da, _, step)) in steps.iter().enumerate() {
+            assert!(
+                *da <= step + 1e-9,
+                "{limits} move {}: A {da}° > step {step}°",
+                i + 1
+            );
+        }
+        // The half turn of the table within one 0.5 mm move stays on the chord in LinuxCNC's
+        // joint interpolation.
+        let rt = machine::round_trip(
+            &path,
+            &opts(),
+            &job("sweep"),
+            &trunnion(limits),
+            Dialect::LinuxCnc,
+            Units::Mm,
+        )
+        .unwrap();
+        assert!(rt.max_position_error_mm <= 1e-3 && rt.max_axis_error_deg <= 0.01);
+        println!(
+            "A in {limits} past the pole at 0.001°: A keeps its sign, C turns {c_pass:.3}° at the pass \
+             (a free trunnion flips A and turns C {c_free:.3}°); {} blocks inserted",
+            rt.inserted_blocks
+        );
+    }
+}
+
+#[test]
 fn rotaries_unwind_at_rapids_within_their_travel() {
     // C limited to ±360°: two chains, each turning the tool axis azimuth by 540°.
     let m = machine::from_json(

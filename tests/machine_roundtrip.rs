@@ -29,13 +29,15 @@ fn round_trips(units: Units) {
     let mut inserted = 0;
     let mut inverse_time_checked = 0;
     let mut programs = 0;
+    // Worst position (mm) and axis (degrees) error of each dialect.
+    let mut by_dialect = vec![(0.0f64, 0.0f64); DIALECTS.len()];
     for (name, planned) in sample_plans() {
         let tilted = along_normals(&planned);
         let o = opts_for(&name);
         for m in MACHINES {
             let mach = machine::builtin(m.name).unwrap();
             let five = !mach.rotaries.is_empty();
-            for &(dialect, dname, _) in DIALECTS {
+            for (d, &(dialect, dname, _)) in DIALECTS.iter().enumerate() {
                 let mut paths = vec![("axis +Z", &planned)];
                 if five && dialect != Dialect::Plain {
                     paths.push(("axis along normals", &tilted));
@@ -87,6 +89,8 @@ fn round_trips(units: Units) {
                     keep(&mut worst_off_arc, rt.max_inserted_axis_off_arc_deg, label);
                     worst_off_segment =
                         worst_off_segment.max(rt.max_inserted_rotary_off_segment_deg);
+                    by_dialect[d].0 = by_dialect[d].0.max(rt.max_position_error_mm);
+                    by_dialect[d].1 = by_dialect[d].1.max(rt.max_axis_error_deg);
                     inserted += rt.inserted_blocks;
                     inverse_time_checked += rt.inverse_time_blocks_checked;
                     programs += 1;
@@ -103,6 +107,9 @@ fn round_trips(units: Units) {
         "  worst tool-axis error {:.3e} deg ({})",
         worst_ax.0, worst_ax.1
     );
+    for (&(_, dname, _), (pos, ax)) in DIALECTS.iter().zip(&by_dialect) {
+        println!("    {dname:<13} position {pos:.3e} mm, tool axis {ax:.3e} deg");
+    }
     assert!(inverse_time_checked > 0, "some G93 feeds are checked");
     println!(
         "  worst relative feed error {:.3e} ({}; {inverse_time_checked} G93 blocks checked)",
