@@ -262,6 +262,159 @@ fn rotaries_cross_the_singular_pose_without_jumping() {
 }
 
 #[test]
+fn rotaries_pass_near_the_singular_pose_with_the_smallest_motion() {
+    // The tool axis sweeps past the pole (+Z, along C) in 1° steps, missing it by `miss`, the
+    // closest approach halfway between two moves. On a machine whose outer rotary is the tilt
+    // (|A| or |B| = tilt) and whose inner one turns with the azimuth, going from one move to
+    // the next either keeps the tilt's sign (outer turns by the tilt change, inner by the
+    // azimuth change Δ) or flips it through the pole (outer by the sum of the tilts, inner by
+    // 180° − Δ). Near the pole Δ approaches 180°: the flip is the small motion; farther off,
+    // keeping is. The rotaries must take the smaller (Euclidean, degrees) of the two at every
+    // move, and the LinuxCNC program must keep the ball centre on the chords.
+    let mut report = Vec::new();
+    for m in five_axis_machines()
+        .into_iter()
+        .filter(|m| !m.name.starts_with("odd"))
+    {
+        let inner = m.inner_rotary().unwrap();
+        for miss in [0.0f64, 1e-5, 1e-3, 0.05, 0.3, 0.5, 2.0] {
+            for azimuth in [0.0f64, 30.0, 135.0, -60.0] {
+                let (s, c) = azimuth.to_radians().sin_cos();
+                let axes: Vec<Vector3> = (-20..20)
+                    .map(|k| {
+                        let t = (k as f64 + 0.5).to_radians();
+                        let v = Vector3::new(t.sin(), miss.to_radians().sin(), t.cos());
+                        Vector3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z).normalize()
+                    })
+                    .collect();
+                let path = sweep(&axes, 3.0, 0.5, 10.0);
+                let label = format!("{} miss {miss}° azimuth {azimuth}°", m.name);
+                let j = joints_of(&path, &m).unwrap_or_else(|e| panic!("{label}: {e}"));
+                let tilt = |v: &Vector3| v.z.clamp(-1.0, 1.0).acos().to_degrees();
+                let mut worst_inner: f64 = 0.0;
+                for i in 1..axes.len() {
+                    let (a, b) = (&axes[i - 1], &axes[i]);
+                    let mut daz = (b.y.atan2(b.x) - a.y.atan2(a.x)).to_degrees().abs();
+                    if daz > 180.0 {
+                        daz = 360.0 - daz;
+                    }
+                    let keep = (tilt(b) - tilt(a)).hypot(daz);
+                    let flip = (tilt(a) + tilt(b)).hypot(180.0 - daz);
+                    let step = (j[i].rotary_deg[0] - j[i - 1].rotary_deg[0])
+                        .hypot(j[i].rotary_deg[1] - j[i - 1].rotary_deg[1]);
+                    assert!(
+                        (step - keep.min(flip)).abs() <= 1e-6,
+                        "{label} move {i}: rotaries moved {step}°, keeping the tilt's sign \
+                         takes {keep}°, flipping it {flip}°"
+                    );
+                    worst_inner = worst_inner
+                        .max((j[i].rotary_deg[inner] - j[i - 1].rotary_deg[inner]).abs());
+                }
+                let rt = machine::round_trip(
+                    &path,
+                    &opts(),
+                    &job("sweep"),
+                    &m,
+                    Dialect::LinuxCnc,
+                    Units::Mm,
+                )
+                .unwrap_or_else(|e| panic!("{label}: {e}"));
+                assert!(
+                    rt.max_position_error_mm <= 1e-3 && rt.max_axis_error_deg <= 0.01,
+                    "{label}: {rt:?}"
+                );
+                if azimuth == 30.0 {
+                    report.push(format!(
+                        "{label}: inner axis turns at most {worst_inner:.4}° per move, {} blocks inserted",
+                        rt.inserted_blocks
+                    ));
+                }
+            }
+        }
+    }
+    for r in report {
+        println!("{r}");
+    }
+}
+
+#[test]
+fn a_limit_met_later_decides_the_way_past_the_pole() {
+    // The tool axis tilts from 40° on one side of the pole to 40° on the other, missing the
+    // pole by 0.001° halfway between two moves. Flipping the tilt's sign there is the smaller
+    // step (a free trunnion does it), but on a trunnion that tilts one way only to 30° it
+    // would end at a tilt of 40° on the wrong side: the rotaries must keep the tilt's sign and
+    // turn C round the pole instead, decided before the limit is met.
+    let axes: Vec<Vector3> = (-40..40)
+        .map(|k| {
+            let t = (k as f64 + 0.5).to_radians();
+            Vector3::new(t.sin(), 1e-3f64.to_radians().sin(), t.cos()).normalize()
+        })
+        .collect();
+    let path = sweep(&axes, 3.0, 0.5, 10.0);
+    let trunnion = |limits: &str| {
+        machine::from_json(&format!(
+            r#"{{"format": "tspath-machine", "version": 1, "name": "one-way",
+            "rotaries": [
+              {{"name": "A", "mount": "table", "axis": [1, 0, 0], "pivot_mm": [0, 0, -80], "limits_deg": {limits}}},
+              {{"name": "C", "mount": "table", "axis": [0, 0, 1]}}
+            ]}}"#
+        ))
+        .unwrap()
+    };
+    let pass = 40; // move index of the first axis past the pole
+    let free = joints_of(&path, &trunnion("[-120, 120]")).unwrap();
+    assert!(
+        free[pass - 1].rotary_deg[0] * free[pass].rotary_deg[0] < 0.0,
+        "a free trunnion flips the tilt's sign: {:?} {:?}",
+        free[pass - 1],
+        free[pass]
+    );
+    let c_free = (free[pass].rotary_deg[1] - free[pass - 1].rotary_deg[1]).abs();
+    assert!(c_free < 1.0, "and turns C a little: {c_free}°");
+    for limits in ["[-120, 30]", "[-30, 120]"] {
+        let j = joints_of(&path, &trunnion(limits)).unwrap_or_else(|e| panic!("{limits}: {e}"));
+        let a: Vec<f64> = j.iter().map(|j| j.rotary_deg[0]).collect();
+        let sign = a[1].signum();
+        assert!(
+            a.iter()
+                .skip(1)
+                .all(|x| x * sign >= 0.0 && x.abs() <= 40.0 + 1e-9),
+            "{limits}: A keeps its sign: {a:?}"
+        );
+        let steps = rotary_steps(&path, &j);
+        let (_, c_pass, _) = steps[pass - 1];
+        assert!(
+            (c_pass - (180.0 - c_free)).abs() < 1e-6,
+            "{limits}: C turns round the pole by the azimuth change, {c_pass}°"
+        );
+        for (i, (da, _, step)) in steps.iter().enumerate() {
+            assert!(
+                *da <= step + 1e-9,
+                "{limits} move {}: A {da}° > step {step}°",
+                i + 1
+            );
+        }
+        // The half turn of the table within one 0.5 mm move stays on the chord in LinuxCNC's
+        // joint interpolation.
+        let rt = machine::round_trip(
+            &path,
+            &opts(),
+            &job("sweep"),
+            &trunnion(limits),
+            Dialect::LinuxCnc,
+            Units::Mm,
+        )
+        .unwrap();
+        assert!(rt.max_position_error_mm <= 1e-3 && rt.max_axis_error_deg <= 0.01);
+        println!(
+            "A in {limits} past the pole at 0.001°: A keeps its sign, C turns {c_pass:.3}° at the pass \
+             (a free trunnion flips A and turns C {c_free:.3}°); {} blocks inserted",
+            rt.inserted_blocks
+        );
+    }
+}
+
+#[test]
 fn rotaries_unwind_at_rapids_within_their_travel() {
     // C limited to ±360°: two chains, each turning the tool axis azimuth by 540°.
     let m = machine::from_json(
@@ -328,7 +481,8 @@ fn rotaries_unwind_at_rapids_within_their_travel() {
 
 #[test]
 fn limits_are_respected_or_the_error_says_which_move_and_axis() {
-    let (name, planned) = sample_plans().remove(0);
+    let name = "dome";
+    let planned = sample_plan(name);
     let tilted = along_normals(&planned);
     // Built-in machines: every rotary within its travel on the dome with normal tool axes.
     for m in five_axis_machines()
@@ -405,7 +559,7 @@ fn limits_are_respected_or_the_error_says_which_move_and_axis() {
     let e = post(
         &tilted,
         &opts(),
-        &job(&name),
+        &job(name),
         &machine::builtin("3-axis").unwrap(),
         Dialect::Fanuc,
         Units::Mm,
@@ -416,7 +570,7 @@ fn limits_are_respected_or_the_error_says_which_move_and_axis() {
     let e = post(
         &tilted,
         &opts(),
-        &job(&name),
+        &job(name),
         &machine::builtin("table-table-ac").unwrap(),
         Dialect::Plain,
         Units::Mm,

@@ -22,32 +22,39 @@ use tspath::machine::{self, post, reader, Dialect, Units, MACHINES};
 /// rs274 prints 4 decimals.
 const PRINT_ROUNDING: f64 = 0.5e-4;
 
-#[test]
-fn rs274_accepts_every_linuxcnc_program_and_sees_the_same_moves() {
-    let dir = scratch("rs274-accept");
+/// Runs rs274 on every LinuxCNC program (both LinuxCNC dialects, mm and inch) of the sample
+/// plans and a sweep through and past the singular pose on the built-in machines `machines`,
+/// and compares its canonical moves with the reader's.
+fn accepts_every_program_on(machines: &[&str], tag: &str) {
+    let dir = scratch(&format!("rs274-accept-{tag}"));
     let mut files = 0;
     let mut blocks = 0;
     let mut inverse_time_blocks = 0;
     let mut worst: f64 = 0.0;
     // The sample plans (tool axis +Z, and along the surface normals), and a sweep of the tool
-    // axis straight through the singular pose and past it at 0.5°.
-    let crossing: Vec<tspath::geom::Vector3> = (-20..=20)
-        .map(|t| axis(t as f64, 30.0))
-        .chain((-20..=20).map(|t| {
+    // axis straight through the singular pose and past it at 0.5° and at 0.001° (where the
+    // rotaries flip the tilt's sign through the pole).
+    let past = |miss_deg: f64, offset: f64| {
+        (-20..=20).map(move |t| {
             tspath::geom::Vector3::new(
-                (t as f64).to_radians().sin(),
-                0.5f64.to_radians().sin(),
+                (t as f64 + offset).to_radians().sin(),
+                miss_deg.to_radians().sin(),
                 1.0,
             )
             .normalize()
-        }))
+        })
+    };
+    let crossing: Vec<tspath::geom::Vector3> = (-20..=20)
+        .map(|t| axis(t as f64, 30.0))
+        .chain(past(0.5, 0.0))
+        .chain(past(1e-3, 0.5))
         .collect();
     let sweep_path = sweep(&crossing, 3.0, 0.5, 10.0);
     let mut cases = sample_plans();
     cases.push(("singular-sweep".into(), sweep_path));
     for (name, planned) in cases {
         let tilted = along_normals(&planned);
-        for m in MACHINES {
+        for m in MACHINES.iter().filter(|m| machines.contains(&m.name)) {
             let mach = machine::builtin(m.name).unwrap();
             let five = !mach.rotaries.is_empty();
             for dialect in [Dialect::LinuxCnc, Dialect::LinuxCncTcp] {
@@ -62,7 +69,8 @@ fn rs274_accepts_every_linuxcnc_program_and_sees_the_same_moves() {
                         paths.push(("normals", if sweeping { &planned } else { &tilted }));
                     }
                     for (what, path) in paths {
-                        let text = post(path, &opts(), &job(&name), &mach, dialect, units).unwrap();
+                        let o = if sweeping { opts() } else { opts_for(&name) };
+                        let text = post(path, &o, &job(&name), &mach, dialect, units).unwrap();
                         let file = dir.join(format!(
                             "{name}-{what}-{}-{}-{}.ngc",
                             m.name,
@@ -128,22 +136,48 @@ fn rs274_accepts_every_linuxcnc_program_and_sees_the_same_moves() {
     }
     assert!(inverse_time_blocks > 0, "some programs use G93");
     println!(
-        "rs274 accepted {files} LinuxCNC programs ({blocks} motion blocks, {inverse_time_blocks} in \
-         G93 inverse time); largest difference between its canonical moves and the reader's: \
-         {worst:.1e} (program units or degrees; it prints 4 decimals)"
+        "rs274 accepted {files} LinuxCNC programs for {} ({blocks} motion blocks, \
+         {inverse_time_blocks} in G93 inverse time); largest difference between its canonical \
+         moves and the reader's: {worst:.1e} (program units or degrees; it prints 4 decimals)",
+        machines.join(", ")
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+// Split by machine so that the test harness runs them side by side.
+
+#[test]
+fn rs274_accepts_every_linuxcnc_program_and_sees_the_same_moves_3_axis_and_ac() {
+    accepts_every_program_on(&["3-axis", "table-table-ac"], "ac");
+}
+
+#[test]
+fn rs274_accepts_every_linuxcnc_program_and_sees_the_same_moves_bc() {
+    accepts_every_program_on(&["table-table-bc", "head-table-bc"], "bc");
+}
+
+#[test]
+fn every_built_in_machine_is_run_through_rs274() {
+    let tested = [
+        "3-axis",
+        "table-table-ac",
+        "table-table-bc",
+        "head-table-bc",
+    ];
+    for m in MACHINES {
+        assert!(tested.contains(&m.name), "add {} to an rs274 test", m.name);
+    }
+}
+
 /// A five-axis LinuxCNC program of the dome with the tool along the normals.
 fn five_axis_program() -> (String, f64) {
-    let (name, planned) = sample_plans().remove(0);
-    let path = along_normals(&planned);
+    let name = "dome";
+    let path = along_normals(&sample_plan(name));
     let mach = machine::builtin("table-table-ac").unwrap();
     let text = post(
         &path,
-        &opts(),
-        &job(&name),
+        &opts_for(name),
+        &job(name),
         &mach,
         Dialect::LinuxCnc,
         Units::Mm,
@@ -206,10 +240,10 @@ fn rs274_rejects_broken_programs() {
     println!("rs274 on a U word: {}", run.message.replace('\n', " | "));
 
     // 3. A feed move before any feed rate (first F removed from a 3-axis program).
-    let (_, planned) = sample_plans().remove(0);
+    let planned = sample_plan("dome");
     let three = post(
         &planned,
-        &opts(),
+        &opts_for("dome"),
         &job("dome"),
         &machine::builtin("3-axis").unwrap(),
         Dialect::LinuxCnc,

@@ -1,31 +1,49 @@
 //! Joint values along a whole path: one inverse-kinematics solution per move, chosen so the
-//! rotaries move continuously and stay within their limits.
+//! rotaries move continuously, as little as possible and within their limits.
 //!
-//! Owns: branch and turn selection, unwinding at rapids, limit errors. Must not: change the
-//! path or format output.
+//! Owns: branch and turn selection, unwinding at rapids, limit errors, and the blocks that keep
+//! joint-space motion on the planned chords ([`linearize`]). Must not: change the path or
+//! format output.
 //!
-//! Rules. Moves between two rapids form a *chain* the tool cuts without leaving the part;
-//! inside a chain every move keeps the orientation branch of the previous one (the sign of the
-//! tilt) and takes its nearest turn, so no rotary jumps; the branch may change only where the
-//! arc of tool axes between two moves meets the singular pose (tool axis along the inner
-//! rotary), and there the inner angle keeps its previous value. When the continuous solution
-//! is outside a limit, the chain must not fall back on a far one (a 180° or 360° swing while
-//! cutting): that is an error naming the move. At the first move of a chain (a rapid, above
-//! the part) the rotaries may take any solution: the one nearest the previous pose for which
-//! the whole chain stays within limits is chosen, which is how rotaries are unwound within
-//! their travel.
+//! Rules. Moves between two rapids form a *chain* the tool cuts without leaving the part.
+//! From one move of a chain to the next the rotaries may take
+//! - the *continuation*: the same orientation branch (the sign of the tilt) at the nearest
+//!   turn — unless the arc of tool axes between the two moves passes through the singular pose
+//!   (tool axis along the inner rotary, usually C), where staying on the branch would swing the
+//!   inner rotary half a turn;
+//! - the *smallest step*: the solution nearest in joint space (either branch, nearest turn).
+//!   Where the tool axis passes near the singular pose this is the flip of the tilt's sign
+//!   through the pole with a small turn of the inner rotary, while the continuation would turn
+//!   the inner rotary by nearly the whole change of the axis' azimuth, up to 180° within one
+//!   short move.
+//!
+//! At the singular pose the inner rotary keeps its value and the next move takes the smallest
+//! step. Anything else (a far turn, the other branch when it is not the smaller step) is a
+//! swing while cutting; when the limits leave only swings, that is an error naming the move. At
+//! the first move of a chain (a rapid, above the part) the rotaries may take any solution
+//! within their limits: that is where they are unwound.
+//!
+//! Among all the sequences these rules allow, the one with the least total rotary travel
+//! (Euclidean, in degrees, rapids included) is chosen by dynamic programming over the whole
+//! path. So a limit met late in a chain decides which way the rotaries go near the pole early
+//! in it (a trunnion that tilts one way only takes the continuation), and a chain starts on the
+//! turn that keeps it within the limits.
 //!
 //! A controller that interpolates joint values moves the ball centre off the straight chord
-//! where the rotaries turn fast; [`linearize`] splits such moves until it stays within the
-//! chordal tolerance.
+//! where the rotaries turn; [`linearize`] splits such moves until it stays within the chordal
+//! tolerance.
 
 use super::kinematics::{Joints, Machine, RotarySolution, Unreachable};
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
 
-/// A limit-forced solution farther than the unconstrained nearest one by more than this
-/// (degrees, in the joint distance) is a jump.
-const JUMP_TOL_DEG: f64 = 1e-6;
+/// Solutions this much (degrees, in joint distance) farther than the nearest one still count as
+/// the smallest step (ties of round-off).
+const STEP_TIE_DEG: f64 = 1e-6;
+
+/// Two solutions whose rotary angles differ by less than this (degrees) after taking whole
+/// turns of endless axes out are the same state of the dynamic programme.
+const SAME_STATE_DEG: f64 = 1e-9;
 
 /// One pose the machine must reach: tool tip and axis in the workpiece frame, and whether
 /// it starts a chain (a rapid above the part, where the rotaries may re-choose).
@@ -75,7 +93,7 @@ fn outside_text(machine: &Machine, s: &RotarySolution) -> String {
         .iter()
         .enumerate()
         .filter_map(|(i, r)| match r.limits_deg {
-            Some((lo, hi)) if s.rotary_deg[i] < lo || s.rotary_deg[i] > hi => Some(format!(
+            Some((lo, hi)) if !r.within(s.rotary_deg[i]) => Some(format!(
                 "{} = {:.4}° outside [{lo}, {hi}]°",
                 r.name, s.rotary_deg[i]
             )),
@@ -85,183 +103,211 @@ fn outside_text(machine: &Machine, s: &RotarySolution) -> String {
         .join(", ")
 }
 
-/// Joint values and the orientation branch they are on (`None` at the singular pose).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Solved {
-    pub joints: Joints,
-    pub branch: Option<u8>,
+/// A state of the dynamic programme: the solution at one move and the cheapest way to it.
+#[derive(Debug, Clone, Copy)]
+struct State {
+    rotary_deg: [f64; 2],
+    /// Orientation branch; `None` at the singular pose.
+    branch: Option<u8>,
+    xyz_mm: [f64; 3],
+    /// Rotary travel from the start of the path (degrees).
+    travel_deg: f64,
+    /// Index of the state at the previous move it comes from.
+    back: usize,
 }
 
-/// The joint values of every pose, or the first move the machine cannot do.
-pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Solved>> {
-    let mut out: Vec<Solved> = Vec::with_capacity(poses.len());
-    let mut previous = [0.0; 2];
-    let mut start = 0;
-    while start < poses.len() {
-        let end = (start + 1..poses.len())
-            .find(|&i| poses[i].starts_chain)
-            .unwrap_or(poses.len());
-        let first = &poses[start];
-        let mut candidates = machine
-            .rotary_solutions(&first.axis, previous, true)
-            .map_err(|Unreachable| unreachable(machine, start, &first.axis))?;
-        if candidates.is_empty() {
-            let nearest = machine
-                .rotary_solutions(&first.axis, previous, false)
-                .map_err(|Unreachable| unreachable(machine, start, &first.axis))?;
-            let why = nearest
-                .first()
-                .map(|s| outside_text(machine, s))
-                .unwrap_or_default();
-            return Err(Error::Machine {
-                location: format!("move {start}"),
-                message: format!(
-                    "tool axis {} needs rotary angles outside the limits of machine `{}` ({}): {why}",
-                    axis_text(&first.axis),
-                    machine.name,
-                    limits_text(machine)
-                ),
-            });
-        }
-        candidates.sort_by(|a, b| {
-            distance(a.rotary_deg, previous)
-                .total_cmp(&distance(b.rotary_deg, previous))
-                .then(a.branch.cmp(&b.branch))
-                .then(a.rotary_deg[0].total_cmp(&b.rotary_deg[0]))
-                .then(a.rotary_deg[1].total_cmp(&b.rotary_deg[1]))
-        });
-        let mut first_error = None;
-        let mut chain = None;
-        for c in &candidates {
-            match follow(machine, poses, start, end, c) {
-                Ok(j) => {
-                    chain = Some(j);
-                    break;
-                }
-                Err(e) => {
-                    first_error.get_or_insert(e);
-                }
-            }
-        }
-        match chain {
-            Some(j) => {
-                previous = j.last().map(|l| l.joints.rotary_deg).unwrap_or(previous);
-                out.extend(j);
-            }
-            None => return Err(first_error.expect("at least one candidate was tried")),
-        }
-        start = end;
-    }
-    Ok(out)
-}
-
-fn branch_of(s: &RotarySolution) -> Option<u8> {
-    (!s.singular).then_some(s.branch)
-}
-
-/// The rotary solution for `axis` nearest `previous` within the limits, on the same branch as
-/// `previous` unless the arc of tool axes from `previous_axis` meets the singular pose; an
-/// error naming move `i` when the limits would force a swing (the nearest solution is
-/// outside them).
-fn continue_to(
-    machine: &Machine,
-    axis: &Vector3,
-    previous_axis: &Vector3,
-    previous: [f64; 2],
-    previous_branch: Option<u8>,
-    i: usize,
-) -> Result<RotarySolution> {
-    let free_branch = previous_branch.is_none() || machine.arc_meets_singular(previous_axis, axis);
-    let keep = |s: &RotarySolution| free_branch || s.singular || Some(s.branch) == previous_branch;
-    let solutions = |limits: bool| -> Result<Vec<RotarySolution>> {
-        let all = machine
-            .rotary_solutions(axis, previous, limits)
-            .map_err(|Unreachable| unreachable(machine, i, axis))?;
-        let same: Vec<RotarySolution> = all.iter().copied().filter(keep).collect();
-        // A branch can end where two solutions merge (the edge of what a tilted axis reaches).
-        Ok(if same.is_empty() && !limits {
-            all
-        } else {
-            same
-        })
-    };
-    let inside = solutions(true)?;
-    let free = solutions(false)?;
-    let nearest = |s: &[RotarySolution]| {
-        s.iter().copied().min_by(|a, b| {
-            distance(a.rotary_deg, previous)
-                .total_cmp(&distance(b.rotary_deg, previous))
-                .then(a.branch.cmp(&b.branch))
-        })
-    };
-    let best_free = nearest(&free).expect("an unlimited solution exists");
-    match nearest(&inside) {
-        Some(b)
-            if distance(b.rotary_deg, previous)
-                <= distance(best_free.rotary_deg, previous) + JUMP_TOL_DEG =>
-        {
-            Ok(b)
-        }
-        forced => {
-            let jump = forced
-                .map(|b| {
-                    format!(
-                        "; the limits leave only a swing of {:.3}° in the rotaries",
-                        distance(b.rotary_deg, previous)
-                    )
-                })
-                .unwrap_or_default();
-            Err(Error::Machine {
-                location: format!("move {i}"),
-                message: format!(
-                    "going on continuously from move {} to tool axis {} needs {} on machine `{}` ({}){jump}; \
-                     widen the limits or plan with a different tool axis there",
-                    i.saturating_sub(1),
-                    axis_text(axis),
-                    outside_text(machine, &best_free),
-                    machine.name,
-                    limits_text(machine)
-                ),
-            })
+impl State {
+    fn joints(&self) -> Joints {
+        Joints {
+            xyz_mm: self.xyz_mm,
+            rotary_deg: self.rotary_deg,
         }
     }
 }
 
-/// Follows one chain from the rotary solution `seed` at `start`, continuously.
-fn follow(
+/// True when `a` and `b` are the same state (endless axes up to whole turns).
+fn same_state(machine: &Machine, a: &State, b: &State) -> bool {
+    a.branch == b.branch
+        && machine.rotaries.iter().enumerate().all(|(k, r)| {
+            let d = a.rotary_deg[k] - b.rotary_deg[k];
+            let d = if r.limits_deg.is_none() {
+                d - 360.0 * (d / 360.0).round()
+            } else {
+                d
+            };
+            d.abs() < SAME_STATE_DEG
+        })
+}
+
+/// The solutions the rules allow at move `i` coming from `from` at move `i − 1` (limits not
+/// yet applied).
+fn allowed(
     machine: &Machine,
     poses: &[PoseRequest],
-    start: usize,
-    end: usize,
-    seed: &RotarySolution,
-) -> Result<Vec<Solved>> {
-    let mut out = Vec::with_capacity(end - start);
-    let mut previous = *seed;
-    for (i, p) in poses.iter().enumerate().take(end).skip(start) {
-        let s = if i == start {
-            *seed
-        } else {
-            continue_to(
-                machine,
-                &p.axis,
-                &poses[i - 1].axis,
-                previous.rotary_deg,
-                branch_of(&previous),
-                i,
-            )?
-        };
-        let xyz_mm = machine.linear_joints(&p.tip, s.rotary_deg);
-        machine.check_linear(&xyz_mm, &format!("move {i}"))?;
-        out.push(Solved {
-            joints: Joints {
-                xyz_mm,
-                rotary_deg: s.rotary_deg,
-            },
-            branch: branch_of(&s),
-        });
-        previous = s;
+    i: usize,
+    from: &State,
+) -> Result<Vec<RotarySolution>> {
+    let p = &poses[i];
+    if i == 0 || p.starts_chain {
+        return machine
+            .rotary_solutions(&p.axis, from.rotary_deg, true)
+            .map_err(|Unreachable| unreachable(machine, i, &p.axis));
+    }
+    let free = machine
+        .rotary_solutions(&p.axis, from.rotary_deg, false)
+        .map_err(|Unreachable| unreachable(machine, i, &p.axis))?;
+    let least = free
+        .iter()
+        .map(|s| distance(s.rotary_deg, from.rotary_deg))
+        .fold(f64::INFINITY, f64::min);
+    let continuation =
+        from.branch.is_some() && !machine.arc_meets_singular(&poses[i - 1].axis, &p.axis);
+    Ok(free
+        .into_iter()
+        .filter(|s| {
+            distance(s.rotary_deg, from.rotary_deg) <= least + STEP_TIE_DEG
+                || (continuation && (s.singular || Some(s.branch) == from.branch))
+        })
+        .collect())
+}
+
+/// The joint values of every pose (see the module documentation for how they are chosen), or
+/// an error naming the first move the machine cannot do.
+pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
+    let home = State {
+        rotary_deg: [0.0; 2],
+        branch: None,
+        xyz_mm: [0.0; 3],
+        travel_deg: 0.0,
+        back: 0,
+    };
+    let mut layers: Vec<Vec<State>> = Vec::with_capacity(poses.len());
+    for (i, p) in poses.iter().enumerate() {
+        let from: &[State] = layers
+            .last()
+            .map(|l| l.as_slice())
+            .unwrap_or(std::slice::from_ref(&home));
+        let mut next: Vec<State> = Vec::new();
+        for (k, f) in from.iter().enumerate() {
+            for s in allowed(machine, poses, i, f)? {
+                let Some(rotary_deg) = machine.within_limits(s.rotary_deg) else {
+                    continue;
+                };
+                let xyz_mm = machine.linear_joints(&p.tip, rotary_deg);
+                if !machine.linear_within_limits(&xyz_mm) {
+                    continue;
+                }
+                let state = State {
+                    rotary_deg,
+                    branch: (!s.singular).then_some(s.branch),
+                    xyz_mm,
+                    travel_deg: f.travel_deg + distance(rotary_deg, f.rotary_deg),
+                    back: k,
+                };
+                match next.iter_mut().find(|n| same_state(machine, n, &state)) {
+                    Some(n) if n.travel_deg <= state.travel_deg => {}
+                    Some(n) => *n = state,
+                    None => next.push(state),
+                }
+            }
+        }
+        if next.is_empty() {
+            return Err(dead_end(machine, poses, i, from));
+        }
+        layers.push(next);
+    }
+    let Some(last) = layers.last() else {
+        return Ok(Vec::new());
+    };
+    let mut k = (0..last.len())
+        .min_by(|&a, &b| last[a].travel_deg.total_cmp(&last[b].travel_deg))
+        .expect("a layer is never empty");
+    let mut out = vec![home.joints(); layers.len()];
+    for (i, layer) in layers.iter().enumerate().rev() {
+        out[i] = layer[k].joints();
+        k = layer[k].back;
     }
     Ok(out)
+}
+
+/// Why no allowed solution exists at move `i`, said from the cheapest state before it.
+fn dead_end(machine: &Machine, poses: &[PoseRequest], i: usize, from: &[State]) -> Error {
+    let p = &poses[i];
+    let f = from
+        .iter()
+        .min_by(|a, b| a.travel_deg.total_cmp(&b.travel_deg))
+        .expect("a layer is never empty");
+    let nearest = |limits: bool| -> Result<Option<RotarySolution>> {
+        let all = machine
+            .rotary_solutions(&p.axis, f.rotary_deg, limits)
+            .map_err(|Unreachable| unreachable(machine, i, &p.axis))?;
+        Ok(all.into_iter().min_by(|a, b| {
+            distance(a.rotary_deg, f.rotary_deg)
+                .total_cmp(&distance(b.rotary_deg, f.rotary_deg))
+                .then(a.branch.cmp(&b.branch))
+        }))
+    };
+    let linear = |s: &RotarySolution| {
+        let xyz = machine.linear_joints(&p.tip, s.rotary_deg);
+        machine.check_linear(&xyz, &format!("move {i}")).err()
+    };
+    let explain = || -> Result<Error> {
+        let free = nearest(false)?.expect("an unlimited solution exists");
+        let inside = nearest(true)?;
+        if i == 0 || p.starts_chain {
+            return Ok(match inside {
+                None => Error::Machine {
+                    location: format!("move {i}"),
+                    message: format!(
+                        "tool axis {} needs rotary angles outside the limits of machine `{}` ({}): {}",
+                        axis_text(&p.axis),
+                        machine.name,
+                        limits_text(machine),
+                        outside_text(machine, &free)
+                    ),
+                },
+                Some(s) => linear(&s).unwrap_or_else(|| stuck(machine, i, &p.axis)),
+            });
+        }
+        if machine.within_limits(free.rotary_deg).is_some() {
+            return Ok(linear(&free).unwrap_or_else(|| stuck(machine, i, &p.axis)));
+        }
+        let swing = inside
+            .map(|s| {
+                format!(
+                    "; the limits leave only a swing of {:.3}° in the rotaries",
+                    distance(s.rotary_deg, f.rotary_deg)
+                )
+            })
+            .unwrap_or_default();
+        Ok(Error::Machine {
+            location: format!("move {i}"),
+            message: format!(
+                "going on continuously from move {} to tool axis {} needs {} on machine `{}` ({}){swing}; \
+                 widen the limits or plan with a different tool axis there",
+                i.saturating_sub(1),
+                axis_text(&p.axis),
+                outside_text(machine, &free),
+                machine.name,
+                limits_text(machine)
+            ),
+        })
+    };
+    explain().unwrap_or_else(|e| e)
+}
+
+/// The fallback explanation when every allowed solution was refused for reasons the nearest
+/// one does not show.
+fn stuck(machine: &Machine, i: usize, axis: &Vector3) -> Error {
+    Error::Machine {
+        location: format!("move {i}"),
+        message: format!(
+            "tool axis {} cannot be reached continuously within the travel of machine `{}` ({})",
+            axis_text(axis),
+            machine.name,
+            limits_text(machine)
+        ),
+    }
 }
 
 /// Most halvings of one move when linearising joint-space motion (2¹² pieces).
@@ -270,27 +316,16 @@ const MAX_LINEARIZE_DEPTH: usize = 12;
 /// Fractions of a move where the joint-interpolated ball centre is compared with the chord.
 const LINEARIZE_SAMPLES: [f64; 3] = [0.25, 0.5, 0.75];
 
-/// One end of a move for [`linearize`]: ball centre, tool axis, joint values and branch.
+/// One end of a move for [`linearize`]: the planned ball centre and the joint values there.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Waypoint {
     pub cl_point: Point3,
-    pub axis: Vector3,
     pub joints: Joints,
-    pub branch: Option<u8>,
-}
-
-/// Unit vector a fraction `t` of the way from `a` to `b` along the great circle.
-pub fn slerp(a: &Vector3, b: &Vector3, t: f64) -> Vector3 {
-    let theta = a.angle(b);
-    if theta < super::kinematics::SINGULAR_CONE_RAD {
-        return (a + (b - a) * t).normalize();
-    }
-    ((a * ((1.0 - t) * theta).sin() + b * (t * theta).sin()) / theta.sin()).normalize()
 }
 
 /// Joint values a fraction `t` of the way from `a` to `b` (what a controller interpolating
 /// joints commands).
-fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
+pub fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
     Joints {
         xyz_mm: [0, 1, 2].map(|k| a.xyz_mm[k] + (b.xyz_mm[k] - a.xyz_mm[k]) * t),
         rotary_deg: [0, 1].map(|k| a.rotary_deg[k] + (b.rotary_deg[k] - a.rotary_deg[k]) * t),
@@ -299,8 +334,10 @@ fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
 
 /// Poses to insert between `a` and `b` (move `i`) so that a controller interpolating the
 /// joints linearly keeps the ball centre within `tol_mm` of the straight chord the planner
-/// meant: the move is halved (ball centre on the chord, tool axis along the great circle)
-/// until every piece is within the tolerance. Empty when the move already is.
+/// meant. The move is halved until every piece is within the tolerance; an inserted pose has
+/// the rotaries where the controller's own interpolation puts them (so it adds no rotary
+/// motion) and the linear axes that put the ball centre on the chord at the same fraction.
+/// Empty when the move already is within the tolerance.
 pub fn linearize(
     machine: &Machine,
     tool_radius_mm: f64,
@@ -347,18 +384,13 @@ fn split(
         });
     }
     let cl_point = a.cl_point + (b.cl_point - a.cl_point) * 0.5;
-    let axis = slerp(&a.axis, &b.axis, 0.5);
-    let s = continue_to(machine, &axis, &a.axis, a.joints.rotary_deg, a.branch, i)?;
-    let xyz_mm = machine.linear_joints(&(cl_point - axis * r), s.rotary_deg);
+    let rotary_deg = lerp_joints(&a.joints, &b.joints, 0.5).rotary_deg;
+    let axis = machine.tool_axis(rotary_deg);
+    let xyz_mm = machine.linear_joints(&(cl_point - axis * r), rotary_deg);
     machine.check_linear(&xyz_mm, &format!("move {i}"))?;
     let m = Waypoint {
         cl_point,
-        axis,
-        joints: Joints {
-            xyz_mm,
-            rotary_deg: s.rotary_deg,
-        },
-        branch: branch_of(&s),
+        joints: Joints { xyz_mm, rotary_deg },
     };
     split(machine, r, a, &m, tol, i, depth + 1, out)?;
     out.push(m);

@@ -136,6 +136,28 @@ fn angle_about(b: &Vector3, p: &Vector3, q: &Vector3) -> Option<f64> {
     Some(b.dot(&pp.cross(&qq)).atan2(pp.dot(&qq)))
 }
 
+/// Angle (rad) from unit vector `v` to the great-circle arc from `p` to `q` (the shorter
+/// one; unit vectors): to its nearest point, which is an end or the foot of `v` on the great
+/// circle when that lies between the ends.
+pub fn angle_to_arc(p: &Vector3, q: &Vector3, v: &Vector3) -> f64 {
+    let ends = v.angle(p).min(v.angle(q));
+    let n = p.cross(q);
+    if n.norm() <= SINGULAR_CONE_RAD {
+        return ends;
+    }
+    let n = n.normalize();
+    let foot = v - n * n.dot(v);
+    if foot.norm() <= SINGULAR_CONE_RAD {
+        return ends;
+    }
+    let foot = foot.normalize();
+    if p.cross(&foot).dot(&n) >= 0.0 && foot.cross(q).dot(&n) >= 0.0 {
+        n.dot(v).abs().min(1.0).asin().min(ends)
+    } else {
+        ends
+    }
+}
+
 /// Wraps an angle (degrees) to the value `a + k·360` nearest `reference`.
 pub fn nearest_turn(a: f64, reference: f64) -> f64 {
     a + 360.0 * ((reference - a) / 360.0).round()
@@ -147,7 +169,8 @@ impl Rotary {
         self.direction * deg.to_radians()
     }
 
-    fn within(&self, deg: f64) -> bool {
+    /// True when `deg` is within this axis' travel (up to output rounding).
+    pub fn within(&self, deg: f64) -> bool {
         match self.limits_deg {
             None => true,
             Some((lo, hi)) => deg >= lo - LIMIT_SLACK_DEG && deg <= hi + LIMIT_SLACK_DEG,
@@ -325,31 +348,40 @@ impl Machine {
     }
 
     /// True when the great-circle arc of tool axes from `p` to `q` passes within
-    /// [`SINGULAR_CONE_RAD`] of the singular pose: only there may the rotary solution change
-    /// branch without a jump.
+    /// [`SINGULAR_CONE_RAD`] of the singular pose (or its opposite).
     pub fn arc_meets_singular(&self, p: &Vector3, q: &Vector3) -> bool {
         let Some(s) = self.singular_axis() else {
             return false;
         };
         let (p, q) = (p.normalize(), q.normalize());
-        let n = p.cross(&q);
-        [s, -s].iter().any(|s| {
-            let ends = s.angle(&p).min(s.angle(&q));
-            let off_plane = if n.norm() > SINGULAR_CONE_RAD {
-                let n = n.normalize();
-                // The closest point of the great circle lies within the arc when it is on the
-                // inner side of both end points.
-                let foot = (s - n * n.dot(s)).normalize();
-                if p.cross(&foot).dot(&n) >= 0.0 && foot.cross(&q).dot(&n) >= 0.0 {
-                    n.dot(s).abs().asin()
-                } else {
-                    ends
-                }
-            } else {
-                ends
-            };
-            off_plane.min(ends) < SINGULAR_CONE_RAD
-        })
+        [s, -s]
+            .iter()
+            .any(|s| angle_to_arc(&p, &q, s) < SINGULAR_CONE_RAD)
+    }
+
+    /// The rotary angles clamped into the travel when they are within it up to output
+    /// rounding; `None` when an angle is outside.
+    pub fn within_limits(&self, rotary_deg: [f64; 2]) -> Option<[f64; 2]> {
+        let mut out = rotary_deg;
+        for (i, r) in self.rotaries.iter().enumerate() {
+            if !r.within(out[i]) {
+                return None;
+            }
+            if let Some((lo, hi)) = r.limits_deg {
+                out[i] = out[i].clamp(lo, hi);
+            }
+        }
+        Some(out)
+    }
+
+    /// True when linear joint values are within the travel (see [`Machine::check_linear`]
+    /// for the error).
+    pub fn linear_within_limits(&self, xyz: &[f64; 3]) -> bool {
+        let l = &self.linear_limits_mm;
+        [l.x, l.y, l.z]
+            .iter()
+            .zip(xyz)
+            .all(|(lim, v)| lim.is_none_or(|(lo, hi)| *v >= lo && *v <= hi))
     }
 
     /// Tool axis in the workpiece frame for rotary angles (degrees).

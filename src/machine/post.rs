@@ -425,7 +425,7 @@ pub fn post_program(
             });
         }
     }
-    let joints: Vec<joints::Solved> = if mode == OutputMode::ThreeAxis {
+    let joints: Vec<Joints> = if mode == OutputMode::ThreeAxis {
         let mut out = Vec::with_capacity(tips.len());
         for (i, (m, t)) in path.moves.iter().zip(&tips).enumerate() {
             if m.tool_axis.angle(&Vector3::z()) > THREE_AXIS_TOL_RAD {
@@ -449,12 +449,9 @@ pub fn post_program(
             }
             let xyz_mm = [t.x, t.y, t.z];
             machine.check_linear(&xyz_mm, &format!("move {i}"))?;
-            out.push(joints::Solved {
-                joints: Joints {
-                    xyz_mm,
-                    rotary_deg: [0.0; 2],
-                },
-                branch: None,
+            out.push(Joints {
+                xyz_mm,
+                rotary_deg: [0.0; 2],
             });
         }
         out
@@ -472,8 +469,6 @@ pub fn post_program(
             .collect();
         joints::solve(machine, &requests)?
     };
-    let branches: Vec<Option<u8>> = joints.iter().map(|s| s.branch).collect();
-    let joints: Vec<Joints> = joints.iter().map(|s| s.joints).collect();
 
     // Rotary words in address order (A, B, C).
     let mut rot_order: Vec<(char, usize)> = if mode == OutputMode::ThreeAxis {
@@ -632,9 +627,7 @@ pub fn post_program(
             let prev = &path.moves[i - 1];
             let way = |m: &crate::plan::Move, k: usize| joints::Waypoint {
                 cl_point: m.cl_point,
-                axis: m.tool_axis,
                 joints: joints[k],
-                branch: branches[k],
             };
             let extra = joints::linearize(
                 machine,
@@ -648,7 +641,7 @@ pub fn post_program(
                 emits.push(Emit {
                     i,
                     inserted: true,
-                    tip: w.cl_point - w.axis * r,
+                    tip: machine.forward(&w.joints).tip,
                     joints: w.joints,
                 });
             }

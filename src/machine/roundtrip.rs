@@ -1,11 +1,12 @@
 //! The round-trip check: plan → program text → [`reader`] → forward kinematics → compare with
-//! the planned ball centres and tool axes (and feeds).
+//! the planned ball centres and tool axes (and feeds). Blocks the post inserted to keep
+//! joint-space motion on the chords are checked as what they are: ball centre on the planned
+//! chord, rotaries on the controller's own joint interpolation between the planned moves.
 //!
 //! Owns: interpreting read moves as tool poses for a machine and dialect, and the comparison.
 //! Must not: write programs (it calls [`super::post::post_program`]).
 
-use super::joints::slerp;
-use super::kinematics::{Joints, Kinematics, Machine, ToolPose};
+use super::kinematics::{angle_to_arc, Joints, Kinematics, Machine, ToolPose};
 use super::post::{self, Dialect, Posted, Source, Units};
 use super::reader::{self, FeedMode, Program, ProgramMove};
 use super::JobInfo;
@@ -14,8 +15,12 @@ use crate::geom::Vector3;
 use crate::plan::{MoveKind, PlanOptions, Toolpath};
 use serde::{Deserialize, Serialize};
 
-/// Inverse-time moves at least this long (mm) have their implied feed checked.
-pub const FEED_CHECK_MIN_MM: f64 = 0.5;
+/// Inverse-time moves at least this long (mm) have their implied feed checked. The implied
+/// feed is the read-back move length times the G93 F word, and that length carries the
+/// rounding of both end points: up to about 0.4 µm each in an inch program (0.127 µm per
+/// written coordinate, and the last rotary digit, 1e-4°, turning points up to 100 mm from
+/// the rotary axes), so about 4e-4 of a 2 mm move — well under the 1e-3 the check is for.
+pub const FEED_CHECK_MIN_MM: f64 = 2.0;
 
 /// What the round trip found (worst cases over the compared moves).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -27,20 +32,34 @@ pub struct RoundTrip {
     pub moves_compared: usize,
     /// Blocks the post added for the safe start and end.
     pub safe_blocks: usize,
-    /// Blocks the post inserted on planned chords (joint-value output); they are compared with
-    /// the chord (ball centre) and the great-circle blend of the axes at the same fraction.
+    /// Blocks the post inserted on planned chords (joint-value output). Their ball centre is
+    /// compared with the planned chord, their rotaries with the joint-space segment between
+    /// the two planned moves around them (the controller's own interpolation).
     pub inserted_blocks: usize,
-    /// Largest distance between a read-back ball centre and the planned one (mm).
+    /// Largest distance between a read-back ball centre and the planned one, or for an
+    /// inserted block the planned chord (mm).
     pub max_position_error_mm: f64,
     pub worst_position_move: usize,
-    /// Largest angle between a read-back tool axis and the planned one (degrees).
+    /// Largest angle between a read-back tool axis and the planned one (degrees; path moves).
     pub max_axis_error_deg: f64,
     pub worst_axis_move: usize,
+    /// Largest distance of an inserted block's rotary angles from the straight joint-space
+    /// segment between the read-back rotaries of the planned moves around it (degrees): zero
+    /// up to the rounding of the words when inserting adds no rotary motion.
+    pub max_inserted_rotary_off_segment_deg: f64,
+    /// Largest angle between an inserted block's tool axis and the great-circle arc between
+    /// the planned axes around it (degrees): how far the machine's joint interpolation takes
+    /// the axis off that arc between planned moves (it passes near the singular pose where the
+    /// rotaries flip the tilt's sign).
+    pub max_inserted_axis_off_arc_deg: f64,
     /// Largest relative error of the tool-tip feed implied by the program (F, or the move
     /// length times the G93 F) against the planned feed; a G93 move slowed by the rotary
     /// speed limit is compared with that limit instead. G93 moves shorter than
     /// [`FEED_CHECK_MIN_MM`] are left out: the rounding of their end points dominates.
     pub max_feed_error_rel: f64,
+    /// Inverse-time blocks whose implied feed was checked (those at least
+    /// [`FEED_CHECK_MIN_MM`] long).
+    pub inverse_time_blocks_checked: usize,
 }
 
 /// The tool pose of each read move on `machine` as `dialect` means it; `None` for blocks in
@@ -130,7 +149,26 @@ pub fn compare(
         worst_position_move: 0,
         max_axis_error_deg: 0.0,
         worst_axis_move: 0,
+        max_inserted_rotary_off_segment_deg: 0.0,
+        max_inserted_axis_off_arc_deg: 0.0,
         max_feed_error_rel: 0.0,
+        inverse_time_blocks_checked: 0,
+    };
+    // The block of each path move, for the segments inserted blocks lie on.
+    let mut block_of_move = vec![None; path.moves.len()];
+    for (k, src) in posted.sources.iter().enumerate() {
+        if let Source::Move(i) = *src {
+            if let Some(b) = block_of_move.get_mut(i) {
+                *b = Some(k);
+            }
+        }
+    }
+    let rotaries_of = |k: usize| -> [f64; 2] {
+        let mut rot = [0.0; 2];
+        for (i, r) in machine.rotaries.iter().enumerate() {
+            rot[i] = program.moves[k].abc_deg[(r.name as u8 - b'A') as usize];
+        }
+        rot
     };
     let mut previous: Option<(ToolPose, [f64; 3])> = None;
     for (k, src) in posted.sources.iter().enumerate() {
@@ -155,37 +193,43 @@ pub fn compare(
             ))
         })?;
         let centre = pose.tip + pose.axis * r;
-        let (e_pos, e_ax) = if inserted {
-            // On the chord from the previous move, at the fraction it is along it.
+        let e_pos = if inserted {
+            // On the chord from the previous move (its nearest point).
             let a = &path.moves[i - 1];
             let ab = planned.cl_point - a.cl_point;
             let t = if ab.norm_squared() > 0.0 {
                 ((centre - a.cl_point).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
             } else {
-                0.5
+                0.0
             };
-            let expect_axis = slerp(&a.tool_axis, &planned.tool_axis, t);
+            let (Some(ka), Some(kb)) = (block_of_move[i - 1], block_of_move[i]) else {
+                return Err(mismatch(format!(
+                    "line {} is inserted in move {i}, but a move around it has no block",
+                    read.line
+                )));
+            };
+            let off = off_segment(rotaries_of(k), rotaries_of(ka), rotaries_of(kb));
+            let off_arc = angle_to_arc(&a.tool_axis, &planned.tool_axis, &pose.axis).to_degrees();
+            if !(off <= out.max_inserted_rotary_off_segment_deg) {
+                out.max_inserted_rotary_off_segment_deg = off;
+            }
+            if !(off_arc <= out.max_inserted_axis_off_arc_deg) {
+                out.max_inserted_axis_off_arc_deg = off_arc;
+            }
             out.inserted_blocks += 1;
-            (
-                (centre - (a.cl_point + ab * t)).norm(),
-                pose.axis.angle(&expect_axis).to_degrees(),
-            )
+            (centre - (a.cl_point + ab * t)).norm()
         } else {
-            (
-                (centre - planned.cl_point).norm(),
-                pose.axis.angle(&planned.tool_axis).to_degrees(),
-            )
+            let e_ax = pose.axis.angle(&planned.tool_axis).to_degrees();
+            if !(e_ax <= out.max_axis_error_deg) {
+                out.max_axis_error_deg = e_ax;
+                out.worst_axis_move = i;
+            }
+            out.moves_compared += 1;
+            (centre - planned.cl_point).norm()
         };
         if !(e_pos <= out.max_position_error_mm) {
             out.max_position_error_mm = e_pos;
             out.worst_position_move = i;
-        }
-        if !(e_ax <= out.max_axis_error_deg) {
-            out.max_axis_error_deg = e_ax;
-            out.worst_axis_move = i;
-        }
-        if !inserted {
-            out.moves_compared += 1;
         }
         let planned_feed = match planned.kind {
             MoveKind::Plunge => opts.plunge_feed_mm_min,
@@ -216,6 +260,9 @@ pub fn compare(
         };
         if let Some(e) = feed_err {
             out.max_feed_error_rel = out.max_feed_error_rel.max(e);
+            if read.feed_mode == FeedMode::InverseTime {
+                out.inverse_time_blocks_checked += 1;
+            }
         }
         previous = Some((pose, read.abc_deg));
     }
@@ -227,4 +274,17 @@ pub fn compare(
         )));
     }
     Ok(out)
+}
+
+/// Distance (degrees) from rotary angles `x` to the joint-space segment from `a` to `b`.
+fn off_segment(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let ax = [x[0] - a[0], x[1] - a[1]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let t = if len2 > 0.0 {
+        ((ax[0] * ab[0] + ax[1] * ab[1]) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (ax[0] - ab[0] * t).hypot(ax[1] - ab[1] * t)
 }

@@ -16,13 +16,18 @@ pub fn opts() -> PlanOptions {
         .with_scallop(0.05)
 }
 
-/// Coarse options a sample can be planned with: a smaller ball where the model's concave
-/// radii are small (the keycaps' fillets are about 1.4 mm).
+/// Coarse options a sample is planned (and posted) with, so that the machine tests stay quick
+/// on every sample: the scallop sets how many passes a path has, and the machine tests need
+/// the shapes (steep walls, poles, saddles, extraordinary points), not fine finishing. A
+/// smaller ball where the model's concave radii are small: the keycaps' fillets are about
+/// 1.4 mm, the bumps-hole dimple's rim about 2.4 mm.
 pub fn opts_for(sample: &str) -> PlanOptions {
-    if sample.starts_with("keycap") {
-        opts().with_tool_radius(0.5).with_scallop(0.02)
-    } else {
-        opts()
+    match sample {
+        "dome" => opts(),
+        s if s.starts_with("keycap") => opts().with_tool_radius(0.5).with_scallop(0.05),
+        "bumps-hole" => opts().with_tool_radius(2.0).with_scallop(0.2),
+        "head" => opts().with_scallop(0.3),
+        _ => opts().with_scallop(0.2),
     }
 }
 
@@ -33,20 +38,18 @@ pub fn job(model: &str) -> JobInfo {
     }
 }
 
-/// Samples the machine tests plan on. The box-like samples (steep walls, extraordinary
-/// points) are being brought in separately.
-pub const MACHINE_SAMPLES: &[&str] = &["dome"];
+/// The planner's path on one sample (tool axis +Z).
+pub fn sample_plan(name: &str) -> Toolpath {
+    let m = samples::load_sample(name).unwrap();
+    isoparametric::plan_zigzag(&m, &opts_for(name), &mut |_| true)
+        .unwrap_or_else(|e| panic!("planning {name}: {e}"))
+}
 
-/// The planner's path on the machine-test samples (tool axis +Z).
+/// The planner's path on every sample (tool axis +Z).
 pub fn sample_plans() -> Vec<(String, Toolpath)> {
     samples::SAMPLES
         .iter()
-        .filter(|s| MACHINE_SAMPLES.contains(&s.name))
-        .map(|s| {
-            let m = samples::load_sample(s.name).unwrap();
-            let p = isoparametric::plan_zigzag(&m, &opts_for(s.name), &mut |_| true).unwrap();
-            (s.name.to_string(), p)
-        })
+        .map(|s| (s.name.to_string(), sample_plan(s.name)))
         .collect()
 }
 
