@@ -13,6 +13,8 @@ const USAGE: &str = "usage:
   tspath sample NAME -o FILE.json
   tspath export MODEL -o FILE.stl|FILE.obj [--chordal MM]
   tspath plan MODEL [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
+              [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
+              [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [-o OUT.nc] [--report REPORT.json]
   tspath machine --list
@@ -197,6 +199,15 @@ fn plan(args: &[String]) -> Result<String> {
             "--machine",
             "--dialect",
             "--units",
+            "--start-patch",
+            "--finish-patch",
+            "--lead",
+            "--tilt",
+            "--shank",
+            "--shank-length",
+            "--holder",
+            "--holder-length",
+            "--max-tilt",
         ],
         &[],
     )?;
@@ -220,10 +231,51 @@ fn plan(args: &[String]) -> Result<String> {
     if let Some(v) = a.number("--feed")? {
         opts.feed_mm_min = v;
     }
+    let patch = |flag: &'static str| -> Result<Option<u32>> {
+        match a.number(flag)? {
+            None => Ok(None),
+            Some(v) if v >= 0.0 && v.fract() == 0.0 => Ok(Some(v as u32)),
+            Some(v) => Err(Error::Io(format!("{flag}: `{v}` is not a patch number"))),
+        }
+    };
+    opts.start_patch = patch("--start-patch")?;
+    opts.finish_patch = patch("--finish-patch")?;
+    if let Some(v) = a.number("--lead")? {
+        opts.lead_deg = v;
+    }
+    if let Some(v) = a.number("--tilt")? {
+        opts.tilt_deg = v;
+    }
+    if let Some(v) = a.number("--shank")? {
+        opts.shank_radius_mm = Some(v);
+    }
+    if let Some(v) = a.number("--shank-length")? {
+        opts.shank_length_mm = v;
+    }
+    if let Some(v) = a.number("--holder")? {
+        opts.holder_radius_mm = v;
+    }
+    if let Some(v) = a.number("--holder-length")? {
+        opts.holder_length_mm = v;
+    }
+    // A three-axis machine keeps the tool axis at +Z; collisions go into the report.
+    opts.max_tilt_deg = match a.number("--max-tilt")? {
+        Some(v) => v,
+        None if mach.rotaries.is_empty() => 0.0,
+        None => opts.max_tilt_deg,
+    };
+    if mach.rotaries.is_empty()
+        && (opts.max_tilt_deg != 0.0 || opts.lead_deg != 0.0 || opts.tilt_deg != 0.0)
+    {
+        return Err(Error::Io(
+            "a three-axis machine cannot tilt the tool: drop --max-tilt/--lead/--tilt or choose a five-axis --machine".into(),
+        ));
+    }
     let t0 = Instant::now();
-    let path = isoparametric::plan_zigzag(&m, &opts, &mut |_| true)?;
-    let mut report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true)?;
+    let mut report = planned.report(&opts);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let path = planned.toolpath;
     let gcode = machine::post(
         &path,
         &opts,

@@ -633,6 +633,13 @@ impl Patch {
         }
     }
 
+    /// Unit normal at patch parameters `(u, v)` (from nearby where the surface is singular).
+    pub fn normal(&self, surface: &Surface, u: f64, v: f64) -> Option<crate::geom::Vector3> {
+        let (p, [x, y]) = self.locate(u * self.width, v * self.height);
+        let face = &surface.faces()[p.face as usize];
+        face.normal(x / face.width, y / face.height)
+    }
+
     /// Point at patch parameters `(u, v)`.
     pub fn subs(&self, surface: &Surface, u: f64, v: f64) -> Point3 {
         let (p, [x, y]) = self.locate(u * self.width, v * self.height);

@@ -1,33 +1,70 @@
-//! Isoparametric zig-zag finishing, patch by patch: passes along one parameter, side steps
-//! from the scallop limit (eq. 5–6, the minimum over samples of the current pass), forward
-//! steps from the chordal tolerance, and retractions between patches.
+//! Patch-ordered, non-retraction isoparametric finishing (Shang et al. 2020, §3).
 //!
-//! This is the strategy's single-patch core; patch ordering and non-retraction transit
-//! between patches build on it.
+//! The patches of the layout are ordered as a travelling-salesman path ([`super::order`]),
+//! transit corners are chosen so each patch finishes where the next one starts
+//! ([`super::corners`]), and each patch is cut by a zig-zag of iso-parameter passes whose side
+//! step comes from the scallop limit (eq. 5–6, the smallest over samples of the pass) and whose
+//! forward steps keep chords within the chordal tolerance. The number of passes decides the
+//! corner a zig-zag ends at; where it ends at the wrong one the scallop height is tuned down
+//! (by 0.1 h, then by bisection) until one more pass fits. Consecutive patches meet at their
+//! shared corner, joined by a feed move.
 
+use super::corners::{self, Crossfeed};
+use super::order::{self, CostMatrix};
 use super::stepover::{self, FeedDir};
-use super::toolpath::{Move, MoveKind, Toolpath};
-use super::PlanOptions;
+use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
+use super::{axis, PlanOptions};
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
+use crate::layout::{ConnectionKind, Patch};
 use crate::model::Model;
-use crate::surface::{DiffGeom, FaceSurface};
+use crate::surface::{DiffGeom, Surface, SurfaceDerivs};
 
 /// Samples along a pass used to find the side step to the next pass.
 const SIDE_STEP_SAMPLES: usize = 33;
 /// Most halvings of a forward step before giving up on meeting the chordal tolerance.
 const MAX_HALVINGS: usize = 40;
+/// Bisection steps of the scallop tuning.
+const TUNING_STEPS: usize = 60;
+/// Points closer than this fraction of the model size are the same corner.
+const CORNER_MATCH_REL: f64 = 1e-7;
 
-/// Surface data at one point of a pass.
-struct PassPoint {
-    cc: Point3,
-    normal: Vector3,
+/// A surface with one parameter square, as the zig-zag sees it.
+pub trait ParamSurface {
+    fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs;
+    fn subs(&self, u: f64, v: f64) -> Point3;
+    /// Unit normal, taken from nearby where the surface is singular.
+    fn normal(&self, u: f64, v: f64) -> Option<Vector3>;
+    /// Where this is, for error messages.
+    fn label(&self) -> String;
+}
+
+/// A layout patch of a surface.
+pub struct PatchView<'a> {
+    pub index: usize,
+    pub patch: &'a Patch,
+    pub surface: &'a Surface,
+}
+
+impl ParamSurface for PatchView<'_> {
+    fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
+        self.patch.derivs(self.surface, u, v)
+    }
+    fn subs(&self, u: f64, v: f64) -> Point3 {
+        self.patch.subs(self.surface, u, v)
+    }
+    fn normal(&self, u: f64, v: f64) -> Option<Vector3> {
+        self.patch.normal(self.surface, u, v)
+    }
+    fn label(&self) -> String {
+        format!("patch {}", self.index)
+    }
 }
 
 /// Fundamental forms at a point; `None` at a singular point (an extraordinary point's limit),
 /// where curvature is undefined and must not enter step computations.
-fn geom_at(face: &FaceSurface, u: f64, v: f64) -> Option<DiffGeom> {
-    DiffGeom::try_from_derivs(&face.derivs(u, v))
+fn geom_at(s: &dyn ParamSurface, u: f64, v: f64) -> Option<DiffGeom> {
+    DiffGeom::try_from_derivs(&s.derivs(u, v))
 }
 
 /// Point on the pass at fixed `w` (the across-parameter), moving parameter `t`.
@@ -38,82 +75,167 @@ fn at(dir: FeedDir, t: f64, w: f64) -> (f64, f64) {
     }
 }
 
-/// Parametric side step from the pass at `w` for scallop `h`, and the most restrictive
-/// point's physical step.
-fn required_step(face: &FaceSurface, dir: FeedDir, w: f64, opts: &PlanOptions) -> Result<f64> {
+/// Parametric side step from the pass at `w` for scallop `h`: the smallest over the pass.
+fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> Result<f64> {
     let mut best = f64::INFINITY;
     for k in 0..SIDE_STEP_SAMPLES {
         let t = k as f64 / (SIDE_STEP_SAMPLES - 1) as f64;
         let (u, v) = at(dir, t, w);
-        let Some(dg) = geom_at(face, u, v) else {
-            continue;
-        };
+        let Some(dg) = geom_at(s, u, v) else { continue };
         let kappa = stepover::cross_curvature(&dg, dir);
-        let g =
-            stepover::side_step(opts.scallop_mm, opts.tool_radius_mm, kappa).map_err(
-                |e| match e {
-                    Error::Degenerate { message, .. } => Error::Degenerate {
-                        location: format!("face {} at (u, v) = ({u:.4}, {v:.4})", face.mesh_face),
-                        message,
-                    },
-                    other => other,
-                },
-            )?;
+        let g = stepover::side_step(h, r, kappa).map_err(|e| match e {
+            Error::Degenerate { message, .. } => Error::Degenerate {
+                location: format!("{} at (u, v) = ({u:.4}, {v:.4})", s.label()),
+                message,
+            },
+            other => other,
+        })?;
         best = best.min(stepover::param_side_step(&dg, dir, g));
     }
     Ok(best)
 }
 
-/// Largest scallop predicted by eq. 5 between passes `w` and `w + dw`, sampled on both.
-fn predicted_between(
-    face: &FaceSurface,
-    dir: FeedDir,
-    w: f64,
-    dw: f64,
-    opts: &PlanOptions,
-) -> Result<f64> {
+/// Largest scallop predicted by eq. 5 between passes `w` and `w + dw`, sampled on both
+/// and half-way.
+fn predicted_between(s: &dyn ParamSurface, dir: FeedDir, w: f64, dw: f64, r: f64) -> f64 {
     let mut worst: f64 = 0.0;
     for &ww in &[w, w + 0.5 * dw, w + dw] {
         for k in 0..SIDE_STEP_SAMPLES {
             let t = k as f64 / (SIDE_STEP_SAMPLES - 1) as f64;
             let (u, v) = at(dir, t, ww.min(1.0));
-            let Some(dg) = geom_at(face, u, v) else {
-                continue;
-            };
+            let Some(dg) = geom_at(s, u, v) else { continue };
             let kappa = stepover::cross_curvature(&dg, dir);
             let g = stepover::physical_side_step(&dg, dir, dw);
-            worst = worst.max(stepover::predicted_scallop(g, opts.tool_radius_mm, kappa));
+            worst = worst.max(stepover::predicted_scallop(g, r, kappa));
         }
     }
-    Ok(worst)
+    worst
 }
 
-/// The across-parameter values of all passes on a face, and the largest predicted scallop.
-pub fn pass_positions(
-    face: &FaceSurface,
-    dir: FeedDir,
-    opts: &PlanOptions,
-) -> Result<(Vec<f64>, f64)> {
-    let mut ws = vec![0.0];
-    let mut worst: f64 = 0.0;
-    let mut w = 0.0;
-    while w < 1.0 {
-        // Conservative: the smallest step required on this pass, half-way and at the next.
-        let d0 = required_step(face, dir, w, opts)?;
-        let d1 = required_step(face, dir, (w + 0.5 * d0).min(1.0), opts)?;
-        let d2 = required_step(face, dir, (w + d0).min(1.0), opts)?;
-        let dw = d0.min(d1).min(d2).min(1.0 - w);
-        if !(dw > 0.0) {
-            return Err(Error::Degenerate {
-                location: format!("face {} at pass {w:.6}", face.mesh_face),
-                message: "side step vanished".into(),
-            });
-        }
-        worst = worst.max(predicted_between(face, dir, w, dw, opts)?);
-        w = if 1.0 - (w + dw) < 1e-12 { 1.0 } else { w + dw };
-        ws.push(w);
+/// Grid intervals of a step profile across a patch.
+const PROFILE_INTERVALS: usize = 256;
+
+/// The side step a pass needs as a function of where it is, for one scallop height `h0`.
+/// Side steps scale exactly with `sqrt(h)` (eq. 5), so one profile serves every height the
+/// tuning tries. Between grid points the smaller neighbouring value is used (a lower
+/// envelope, on the safe side).
+pub struct StepProfile {
+    d: Vec<f64>,
+    h0: f64,
+}
+
+impl StepProfile {
+    /// Samples the required step on a grid across the patch.
+    pub fn new(s: &dyn ParamSurface, dir: FeedDir, h0: f64, r: f64) -> Result<Self> {
+        let d = (0..=PROFILE_INTERVALS)
+            .map(|i| required_step(s, dir, i as f64 / PROFILE_INTERVALS as f64, h0, r))
+            .collect::<Result<Vec<f64>>>()?;
+        Ok(StepProfile { d, h0 })
     }
-    Ok((ws, worst))
+
+    /// Required parametric step at `w` for scallop `h`.
+    fn step(&self, w: f64, h: f64) -> f64 {
+        let x = (w.clamp(0.0, 1.0) * PROFILE_INTERVALS as f64).min(PROFILE_INTERVALS as f64 - 1e-9);
+        let i = x.floor() as usize;
+        self.d[i].min(self.d[i + 1]) * (h / self.h0).sqrt()
+    }
+
+    /// Pass positions for scallop `h`: from 0, each step the smallest needed on the pass,
+    /// half-way and at the next pass; the last pass on 1.
+    pub fn passes(&self, h: f64) -> Vec<f64> {
+        let mut ws = vec![0.0];
+        let mut w = 0.0;
+        while w < 1.0 {
+            let d0 = self.step(w, h);
+            let d1 = self.step(w + 0.5 * d0, h);
+            let d2 = self.step(w + d0, h);
+            let dw = d0.min(d1).min(d2).min(1.0 - w).max(MIN_PARAM_STEP);
+            w = if 1.0 - (w + dw) < 1e-12 { 1.0 } else { w + dw };
+            ws.push(w);
+        }
+        ws
+    }
+}
+
+/// Smallest parametric side step taken (a guard against runaway pass counts).
+const MIN_PARAM_STEP: f64 = 1e-9;
+
+/// Largest scallop predicted by eq. 5 over all adjacent passes.
+fn predicted(s: &dyn ParamSurface, dir: FeedDir, ws: &[f64], r: f64) -> f64 {
+    let mut sorted = ws.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted
+        .windows(2)
+        .map(|w| predicted_between(s, dir, w[0], w[1] - w[0], r))
+        .fold(0.0, f64::max)
+}
+
+/// The across-parameter values of all passes for scallop `h`, and the largest predicted
+/// scallop between them.
+pub fn pass_positions(
+    s: &dyn ParamSurface,
+    dir: FeedDir,
+    h: f64,
+    r: f64,
+) -> Result<(Vec<f64>, f64)> {
+    let ws = StepProfile::new(s, dir, h, r)?.passes(h);
+    let pred = predicted(s, dir, &ws, r);
+    Ok((ws, pred))
+}
+
+/// Passes with a count of the wanted parity: with `h`, or with the scallop tuned down until
+/// one more pass fits (0.1 h steps, then bisection). Returns the passes, the scallop height
+/// used and the predicted scallop.
+fn tuned_passes(
+    s: &dyn ParamSurface,
+    dir: FeedDir,
+    odd: bool,
+    h: f64,
+    r: f64,
+) -> Result<(Vec<f64>, f64, f64)> {
+    let profile = StepProfile::new(s, dir, h, r)?;
+    let done = |ws: Vec<f64>, hh: f64| {
+        let pred = predicted(s, dir, &ws, r);
+        Ok((ws, hh, pred))
+    };
+    let ws = profile.passes(h);
+    let n = ws.len();
+    if (n % 2 == 1) == odd {
+        return done(ws, h);
+    }
+    let (mut hi, mut lo) = (h, h);
+    for k in 1..10 {
+        lo = h * (1.0 - 0.1 * k as f64);
+        let m = profile.passes(lo).len();
+        if m == n + 1 {
+            return done(profile.passes(lo), lo);
+        }
+        if m > n + 1 {
+            break;
+        }
+        hi = lo;
+    }
+    // Bisection between `hi` (n passes) and `lo` (more than n + 1).
+    for _ in 0..TUNING_STEPS {
+        let mid = 0.5 * (hi + lo);
+        let m = profile.passes(mid).len();
+        if m == n + 1 {
+            return done(profile.passes(mid), mid);
+        }
+        if m <= n {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    // The count jumps past n + 1: add a pass half-way across the widest gap of the n-pass
+    // solution instead (the scallop only shrinks).
+    let mut ws = profile.passes(hi);
+    let k = (0..ws.len() - 1)
+        .max_by(|&a, &b| (ws[a + 1] - ws[a]).total_cmp(&(ws[b + 1] - ws[b])))
+        .unwrap_or(0);
+    ws.insert(k + 1, 0.5 * (ws[k] + ws[k + 1]));
+    done(ws, hi)
 }
 
 /// Distance from `p` to the segment `a`–`b`.
@@ -128,134 +250,343 @@ fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
     (p - (a + ab * t)).norm()
 }
 
-fn pass_point(face: &FaceSurface, dir: FeedDir, t: f64, w: f64) -> Result<PassPoint> {
+/// Contact point and unit normal on a pass.
+fn pass_point(s: &dyn ParamSurface, dir: FeedDir, t: f64, w: f64) -> Result<(Point3, Vector3)> {
     let (u, v) = at(dir, t, w);
-    let normal = face.normal(u, v).ok_or_else(|| Error::Degenerate {
-        location: format!("face {} at (u, v) = ({u:.6}, {v:.6})", face.mesh_face),
+    let n = s.normal(u, v).ok_or_else(|| Error::Degenerate {
+        location: format!("{} at (u, v) = ({u:.6}, {v:.6})", s.label()),
         message: "the surface has no tangent plane here or nearby".into(),
     })?;
-    Ok(PassPoint {
-        cc: face.subs(u, v),
-        normal,
-    })
+    Ok((s.subs(u, v), n))
 }
 
 /// Moving-parameter values along the pass at `w` so that chords of both the contact curve
-/// and the ball-centre curve stay within the chordal tolerance.
+/// and the ball-centre curve stay within `tol` (mm).
 pub fn forward_steps(
-    face: &FaceSurface,
+    s: &dyn ParamSurface,
     dir: FeedDir,
     w: f64,
-    opts: &PlanOptions,
+    tol: f64,
+    r: f64,
 ) -> Result<Vec<f64>> {
-    let r = opts.tool_radius_mm;
-    let tol = opts.chordal_mm;
     let mut ts = vec![0.0];
     let mut t = 0.0;
+    let mut p0 = pass_point(s, dir, 0.0, w)?;
     while t < 1.0 {
         let (u, v) = at(dir, t, w);
-        let d = face.derivs(u, v);
+        let d = s.derivs(u, v);
         let (c1, c2) = match dir {
             FeedDir::AlongU => (d.su, d.suu),
             FeedDir::AlongV => (d.sv, d.svv),
         };
         let speed = c1.norm();
-        let k = c1.cross(&c2).norm() / (speed * speed * speed);
+        let k = if speed > 0.0 {
+            c1.cross(&c2).norm() / (speed * speed * speed)
+        } else {
+            0.0
+        };
         // Bound the curvature of the ball-centre curve too (radius shrinks by r on concave).
         let k_cl = if k * r < 0.5 {
             k / (1.0 - k * r)
         } else {
             2.0 * k
         };
-        let mut dt = (stepover::chord_step(tol, k_cl) / speed)
-            .min(1.0 - t)
-            .min(0.125);
-        let p0 = pass_point(face, dir, t, w)?;
-        let mut ok = false;
+        let first = if speed > 0.0 {
+            stepover::chord_step(tol, k_cl) / speed
+        } else {
+            1e-3
+        };
+        let mut dt = first.min(1.0 - t).min(0.125);
+        let mut accepted = None;
         for _ in 0..MAX_HALVINGS {
-            let pm = pass_point(face, dir, t + 0.5 * dt, w)?;
-            let p1 = pass_point(face, dir, t + dt, w)?;
-            let cc_dev = dist_to_segment(&pm.cc, &p0.cc, &p1.cc);
-            let cl = |p: &PassPoint| p.cc + p.normal * r;
-            let cl_dev = dist_to_segment(&cl(&pm), &cl(&p0), &cl(&p1));
-            if cc_dev <= tol && cl_dev <= tol {
-                ok = true;
+            let pm = pass_point(s, dir, t + 0.5 * dt, w)?;
+            let p1 = pass_point(s, dir, t + dt, w)?;
+            let cl = |p: &(Point3, Vector3)| p.0 + p.1 * r;
+            if dist_to_segment(&pm.0, &p0.0, &p1.0) <= tol
+                && dist_to_segment(&cl(&pm), &cl(&p0), &cl(&p1)) <= tol
+            {
+                accepted = Some(p1);
                 break;
             }
             dt *= 0.5;
         }
-        if !ok {
+        let Some(p1) = accepted else {
             return Err(Error::Degenerate {
-                location: format!("face {} near parameter {t:.6}", face.mesh_face),
+                location: format!("{} near parameter {t:.6}", s.label()),
                 message: "the chordal tolerance cannot be met (a crease or cusp?)".into(),
             });
-        }
+        };
         t = if 1.0 - (t + dt) < 1e-12 { 1.0 } else { t + dt };
         ts.push(t);
+        p0 = p1;
     }
     Ok(ts)
 }
 
-/// Plans a zig-zag on every domain face, joined by retractions. `progress` receives the
-/// fraction done and returns `false` to cancel.
-pub fn plan_zigzag(
+/// A planned path with its patch order.
+#[derive(Debug, Clone)]
+pub struct Planned {
+    pub toolpath: Toolpath,
+    /// Retractions the layout forced (no non-retraction order and corners existed).
+    pub forced_retractions: usize,
+    /// What the tool-axis assignment found.
+    pub axes: axis::AxisStats,
+}
+
+impl Planned {
+    /// The report of this plan, with notes on forced retractions and collisions.
+    pub fn report(&self, opts: &PlanOptions) -> super::PlanReport {
+        let mut r =
+            self.toolpath
+                .report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
+        if self.forced_retractions > 0 {
+            r.notes.push(format!(
+                "no patch order and transit corners avoid retractions on this layout: {} retraction(s) used",
+                self.forced_retractions
+            ));
+        }
+        if self.axes.tilted > 0 {
+            r.notes.push(format!(
+                "the tool axis tilts away from +Z at {} points to keep the shank and holder clear",
+                self.axes.tilted
+            ));
+        }
+        if let Some(p) = self.axes.first_blocked {
+            r.notes.push(format!(
+                "with the tool axis at +Z the shank or holder would hit the model at {} points, the first at ball centre ({:.3}, {:.3}, {:.3}) mm: use a five-axis machine, a longer shank or a smaller holder",
+                self.axes.blocked, p.x, p.y, p.z
+            ));
+        }
+        r
+    }
+}
+
+/// Identity of each patch corner: corners at the same point share an id.
+pub fn corner_ids(model: &Model) -> Vec<[u32; 4]> {
+    let tol = CORNER_MATCH_REL * model.surface.bbox().diagonal().max(1.0);
+    let mut points: Vec<Point3> = Vec::new();
+    model
+        .layout
+        .patches
+        .iter()
+        .map(|p| {
+            [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| {
+                let q = p.subs(&model.surface, u, v);
+                match points.iter().position(|x| (x - q).norm() <= tol) {
+                    Some(i) => i as u32,
+                    None => {
+                        points.push(q);
+                        (points.len() - 1) as u32
+                    }
+                }
+            })
+        })
+        .collect()
+}
+
+/// Travelling-salesman costs between the model's patches.
+pub fn patch_costs(model: &Model) -> CostMatrix {
+    let mut m = CostMatrix::new(model.layout.len());
+    for c in &model.layout.connections {
+        let cost = match c.kind {
+            ConnectionKind::Boundary => order::BOUNDARY_COST,
+            ConnectionKind::Corner => order::CORNER_COST,
+        };
+        m.connect(c.a as usize, c.b as usize, cost);
+    }
+    m
+}
+
+/// Arc length of a patch's iso-lines: the total path length of a zig-zag with crossfeed
+/// `c` is about the length of one pass times the number of passes, which goes with the
+/// length across; so the shorter path crosses the longer way.
+fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
+    let len = |along_u: bool| -> f64 {
+        let mut total = 0.0;
+        for w in [0.25, 0.5, 0.75] {
+            let mut prev = if along_u {
+                view.subs(0.0, w)
+            } else {
+                view.subs(w, 0.0)
+            };
+            for k in 1..=16 {
+                let t = k as f64 / 16.0;
+                let p = if along_u {
+                    view.subs(t, w)
+                } else {
+                    view.subs(w, t)
+                };
+                total += (p - prev).norm();
+                prev = p;
+            }
+        }
+        total
+    };
+    // Passes along u (crossfeed V) are as long as the u-lines; there are as many as the
+    // v-extent needs: the path length is about len_u · len_v / g either way, but fewer, longer
+    // passes mean fewer reversals, so cut along the longer direction.
+    if len(true) >= len(false) {
+        Crossfeed::V
+    } else {
+        Crossfeed::U
+    }
+}
+
+/// Plans the whole model: patch order, transit corners, per-patch zig-zags, tool axes.
+/// `progress` receives the fraction done and returns `false` to cancel.
+pub fn plan(
     model: &Model,
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
-) -> Result<Toolpath> {
+) -> Result<Planned> {
     opts.validate()?;
-    let surface = &model.surface;
+    let np = model.layout.len();
+    if np == 0 {
+        return Err(Error::InvalidMesh(
+            "the model has no patches to machine".into(),
+        ));
+    }
+    for (name, p) in [
+        ("start_patch", opts.start_patch),
+        ("finish_patch", opts.finish_patch),
+    ] {
+        if let Some(p) = p {
+            if p as usize >= np {
+                return Err(Error::param(
+                    name,
+                    format!(
+                        "patch {p} does not exist; the model has patches 0 to {}",
+                        np - 1
+                    ),
+                ));
+            }
+        }
+    }
     let r = opts.tool_radius_mm;
-    let axis = Vector3::z();
-    let safe_z = surface.bbox().max[2] + r * 2.0 + opts.clearance_mm;
-    let dir = FeedDir::AlongU;
+    let views: Vec<PatchView> = model
+        .layout
+        .patches
+        .iter()
+        .enumerate()
+        .map(|(index, patch)| PatchView {
+            index,
+            patch,
+            surface: &model.surface,
+        })
+        .collect();
+    let preferred: Vec<Crossfeed> = views
+        .iter()
+        .map(|v| match opts.crossfeed {
+            Some(c) => c,
+            None => preferred_crossfeed(v),
+        })
+        .collect();
+    let start = opts.start_patch.unwrap_or(0) as usize;
+    let finish = opts
+        .finish_patch
+        .map(|f| f as usize)
+        .filter(|&f| f != start || np == 1);
+    let costs = patch_costs(model);
+    let order = order::patch_order(&costs, start, finish);
+    let ids = corner_ids(model);
+    let (transits, forced) = corners::select(&order, &ids, &preferred, None);
+    let safe_z = model.surface.bbox().max[2] + 2.0 * r + opts.clearance_mm;
     let mut moves: Vec<Move> = Vec::new();
+    let mut runs: Vec<PatchRun> = Vec::new();
     let mut worst: f64 = 0.0;
-    let nfaces = surface.faces().len();
-    for (fi, face) in surface.faces().iter().enumerate() {
-        let (ws, pred) = pass_positions(face, dir, opts)?;
+    for (k, tr) in transits.iter().enumerate() {
+        let view = &views[tr.patch];
+        let (su, sv) = corners::corner_uv(tr.start_corner);
+        let (fu, fv) = corners::corner_uv(tr.finish_corner);
+        let (dir, odd) = match tr.crossfeed {
+            // Passes u = const step in u, cutting along v.
+            Crossfeed::U => (FeedDir::AlongV, fv != sv),
+            Crossfeed::V => (FeedDir::AlongU, fu != su),
+        };
+        let (mut ws, h_used, pred) = tuned_passes(view, dir, odd, opts.scallop_mm, r)?;
         worst = worst.max(pred);
+        // The passes start on the start corner's side and each runs away from the corner's
+        // coordinate along the pass first.
+        let (w_start, t_start) = match dir {
+            FeedDir::AlongV => (su, sv),
+            FeedDir::AlongU => (sv, su),
+        };
+        if w_start == 1 {
+            ws.reverse();
+        }
+        let first_move = moves.len();
         let nlines = ws.len();
         for (li, &w) in ws.iter().enumerate() {
-            let mut ts = forward_steps(face, dir, w, opts)?;
-            if li % 2 == 1 {
-                ts.reverse();
+            let mut ts = forward_steps(view, dir, w, opts.chordal_mm, r)?;
+            let reversed = (li % 2 == 1) != (t_start == 1);
+            if reversed {
+                ts = ts.iter().rev().copied().collect();
             }
-            for (k, &t) in ts.iter().enumerate() {
-                let p = pass_point(face, dir, t, w)?;
-                let cl = p.cc + p.normal * r;
-                let mk = |kind, cl_point: Point3| Move {
+            for (j, &t) in ts.iter().enumerate() {
+                let (cc, n) = pass_point(view, dir, t, w)?;
+                let cl = cc + n * r;
+                let mv = |kind| Move {
                     kind,
-                    cc_point: p.cc,
-                    cl_point,
-                    tool_axis: axis,
-                    patch: fi as u32,
+                    cc_point: cc,
+                    cl_point: cl,
+                    tool_axis: Vector3::z(),
+                    patch: tr.patch as u32,
                     line: li as u32,
                 };
-                if k == 0 {
+                if j == 0 {
                     if li == 0 {
-                        // Approach: rapid above the start, then plunge onto it.
-                        if let Some(last) = moves.last().copied() {
+                        if k == 0 || tr.retract_before {
+                            if let Some(last) = moves.last().copied() {
+                                moves.push(Move {
+                                    kind: MoveKind::Retract,
+                                    cl_point: Point3::new(last.cl_point.x, last.cl_point.y, safe_z),
+                                    ..last
+                                });
+                            }
                             moves.push(Move {
-                                kind: MoveKind::Retract,
-                                cl_point: Point3::new(last.cl_point.x, last.cl_point.y, safe_z),
-                                ..last
+                                cl_point: Point3::new(cl.x, cl.y, safe_z),
+                                ..mv(MoveKind::Rapid)
                             });
+                            moves.push(mv(MoveKind::Plunge));
+                        } else {
+                            // Transit from the previous patch's finishing corner.
+                            moves.push(mv(MoveKind::Link));
                         }
-                        moves.push(mk(MoveKind::Rapid, Point3::new(cl.x, cl.y, safe_z)));
-                        moves.push(mk(MoveKind::Plunge, cl));
                     } else {
-                        moves.push(mk(MoveKind::Link, cl));
+                        link_between(
+                            view,
+                            dir,
+                            &mut moves,
+                            ws[li - 1],
+                            w,
+                            t,
+                            opts,
+                            r,
+                            tr.patch,
+                            li,
+                        )?;
+                        moves.push(mv(MoveKind::Link));
                     }
                 } else {
-                    moves.push(mk(MoveKind::Feed, cl));
+                    moves.push(mv(MoveKind::Feed));
                 }
             }
-            let frac = (fi as f64 + (li + 1) as f64 / nlines as f64) / nfaces as f64;
-            if !progress(frac) {
+            let frac = (k as f64 + (li + 1) as f64 / nlines as f64) / transits.len() as f64;
+            if !progress(0.8 * frac) {
                 return Err(Error::Cancelled);
             }
         }
+        runs.push(PatchRun {
+            patch: tr.patch as u32,
+            start_corner: tr.start_corner,
+            finish_corner: tr.finish_corner,
+            crossfeed: tr.crossfeed,
+            passes: nlines,
+            scallop_used_mm: h_used,
+            retract_before: tr.retract_before || k == 0,
+            first_move,
+            last_move: moves.len() - 1,
+        });
     }
     if let Some(last) = moves.last().copied() {
         moves.push(Move {
@@ -264,9 +595,86 @@ pub fn plan_zigzag(
             ..last
         });
     }
-    Ok(Toolpath {
+    let mut toolpath = Toolpath {
         tool_radius_mm: r,
         moves,
         max_predicted_scallop_mm: worst,
+        runs,
+    };
+    let axes = axis::assign(model, &mut toolpath, opts, &mut |f| progress(0.8 + 0.2 * f))?;
+    Ok(Planned {
+        toolpath,
+        forced_retractions: forced,
+        axes,
     })
+}
+
+/// Feed moves along the patch boundary from pass `w0` to pass `w1` at parameter `t`, split
+/// where one straight link would leave the chordal tolerance (the last point is added by the
+/// caller).
+#[allow(clippy::too_many_arguments)]
+fn link_between(
+    s: &dyn ParamSurface,
+    dir: FeedDir,
+    moves: &mut Vec<Move>,
+    w0: f64,
+    w1: f64,
+    t: f64,
+    opts: &PlanOptions,
+    r: f64,
+    patch: usize,
+    line: usize,
+) -> Result<()> {
+    let other = match dir {
+        FeedDir::AlongU => FeedDir::AlongV,
+        FeedDir::AlongV => FeedDir::AlongU,
+    };
+    let (a, b) = (w0.min(w1), w0.max(w1));
+    // Points between the passes on the boundary line, by the same chordal rule.
+    let mut inner = Vec::new();
+    let mut cur = a;
+    let mut p0 = pass_point(s, other, a, t)?;
+    while b - cur > 1e-12 {
+        let mut dt = b - cur;
+        for _ in 0..MAX_HALVINGS {
+            let pm = pass_point(s, other, cur + 0.5 * dt, t)?;
+            let p1 = pass_point(s, other, cur + dt, t)?;
+            let cl = |p: &(Point3, Vector3)| p.0 + p.1 * r;
+            if dist_to_segment(&pm.0, &p0.0, &p1.0) <= opts.chordal_mm
+                && dist_to_segment(&cl(&pm), &cl(&p0), &cl(&p1)) <= opts.chordal_mm
+            {
+                break;
+            }
+            dt *= 0.5;
+        }
+        cur += dt;
+        if b - cur > 1e-12 {
+            inner.push(cur);
+        }
+        p0 = pass_point(s, other, cur, t)?;
+    }
+    if w1 < w0 {
+        inner.reverse();
+    }
+    for w in inner {
+        let (cc, n) = pass_point(s, other, w, t)?;
+        moves.push(Move {
+            kind: MoveKind::Link,
+            cc_point: cc,
+            cl_point: cc + n * r,
+            tool_axis: Vector3::z(),
+            patch: patch as u32,
+            line: line as u32,
+        });
+    }
+    Ok(())
+}
+
+/// The planned tool path alone (see [`plan`]).
+pub fn plan_zigzag(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<Toolpath> {
+    plan(model, opts, progress).map(|p| p.toolpath)
 }

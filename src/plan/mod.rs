@@ -4,10 +4,13 @@
 //! Must not: parse files or write G-code; planners take a [`Model`](crate::model::Model)
 //! and return a [`Toolpath`].
 
+pub mod axis;
+pub mod corners;
 pub mod isoparametric;
 pub mod options;
+pub mod order;
 pub mod stepover;
 pub mod toolpath;
 
 pub use options::PlanOptions;
-pub use toolpath::{Move, MoveKind, PlanReport, Toolpath};
+pub use toolpath::{Move, MoveKind, PatchRun, PlanReport, Toolpath};

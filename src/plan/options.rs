@@ -1,6 +1,7 @@
 //! Planning options: the tool, the accuracy asked for, and the feeds. One struct, each field
 //! in the unit its name says, each default chosen to work on every sample model.
 
+use super::corners::Crossfeed;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -25,6 +26,31 @@ pub struct PlanOptions {
     pub plunge_feed_mm_min: f64,
     /// Spindle speed (rev/min). Default 12000 rpm.
     pub spindle_rpm: f64,
+    /// Patch the path starts on. Default patch 0.
+    pub start_patch: Option<u32>,
+    /// Patch the path should finish on. Default: wherever the shortest order ends.
+    pub finish_patch: Option<u32>,
+    /// Crossfeed direction for every patch (`U`: passes are lines u = const). Default: per
+    /// patch, the one with fewer, longer passes.
+    pub crossfeed: Option<Crossfeed>,
+    /// Lead angle: the tool axis tilted forward along the feed (degrees). Default 0°.
+    pub lead_deg: f64,
+    /// Tilt angle: the tool axis tilted sideways, across the feed (degrees). Default 0°.
+    pub tilt_deg: f64,
+    /// Radius of the shank above the ball (mm). Default: the ball radius.
+    pub shank_radius_mm: Option<f64>,
+    /// Cutting length above the ball centre: the fluted part of radius `tool_radius_mm`,
+    /// which cuts and so may touch steep walls (mm). Default: four ball radii.
+    pub flute_length_mm: Option<f64>,
+    /// Length of the shank from the ball centre to the holder (mm). Default 20 mm.
+    pub shank_length_mm: f64,
+    /// Radius of the holder (mm). Default 10 mm.
+    pub holder_radius_mm: f64,
+    /// Length of the holder (mm). Default 40 mm.
+    pub holder_length_mm: f64,
+    /// Largest tilt of the tool axis from +Z the planner may use to clear the shank and
+    /// holder (degrees). Default 60°; 0° plans three-axis (the axis stays +Z).
+    pub max_tilt_deg: f64,
 }
 
 impl Default for PlanOptions {
@@ -37,6 +63,17 @@ impl Default for PlanOptions {
             feed_mm_min: 1000.0,
             plunge_feed_mm_min: 300.0,
             spindle_rpm: 12000.0,
+            start_patch: None,
+            finish_patch: None,
+            crossfeed: None,
+            lead_deg: 0.0,
+            tilt_deg: 0.0,
+            shank_radius_mm: None,
+            flute_length_mm: None,
+            shank_length_mm: 20.0,
+            holder_radius_mm: 10.0,
+            holder_length_mm: 40.0,
+            max_tilt_deg: 60.0,
         }
     }
 }
@@ -68,6 +105,43 @@ impl PlanOptions {
         self
     }
 
+    /// Sets the shank and holder (mm).
+    pub fn with_holder(
+        mut self,
+        shank_radius: f64,
+        shank_length: f64,
+        holder_radius: f64,
+        holder_length: f64,
+    ) -> Self {
+        self.shank_radius_mm = Some(shank_radius);
+        self.shank_length_mm = shank_length;
+        self.holder_radius_mm = holder_radius;
+        self.holder_length_mm = holder_length;
+        self
+    }
+    /// Sets lead and tilt (degrees).
+    pub fn with_lead_tilt(mut self, lead_deg: f64, tilt_deg: f64) -> Self {
+        self.lead_deg = lead_deg;
+        self.tilt_deg = tilt_deg;
+        self
+    }
+    /// Sets the start and suggested finish patches.
+    pub fn with_patches(mut self, start: Option<u32>, finish: Option<u32>) -> Self {
+        self.start_patch = start;
+        self.finish_patch = finish;
+        self
+    }
+
+    /// The cutting length above the ball centre, defaulting to four ball radii (mm).
+    pub fn flute_length(&self) -> f64 {
+        self.flute_length_mm.unwrap_or(4.0 * self.tool_radius_mm)
+    }
+
+    /// The shank radius, defaulting to the ball radius (mm).
+    pub fn shank_radius(&self) -> f64 {
+        self.shank_radius_mm.unwrap_or(self.tool_radius_mm)
+    }
+
     /// Checks every field; the error names the field and the range it must be in.
     pub fn validate(&self) -> Result<()> {
         fn positive(name: &'static str, v: f64, unit: &str) -> Result<()> {
@@ -87,6 +161,47 @@ impl PlanOptions {
         positive("feed_mm_min", self.feed_mm_min, "mm/min")?;
         positive("plunge_feed_mm_min", self.plunge_feed_mm_min, "mm/min")?;
         positive("spindle_rpm", self.spindle_rpm, "rev/min")?;
+        positive("shank_length_mm", self.shank_length_mm, "mm")?;
+        positive("holder_radius_mm", self.holder_radius_mm, "mm")?;
+        positive("holder_length_mm", self.holder_length_mm, "mm")?;
+        positive("shank_radius_mm", self.shank_radius(), "mm")?;
+        if !(self.flute_length().is_finite()
+            && self.flute_length() >= 0.0
+            && self.flute_length() < self.shank_length_mm)
+        {
+            return Err(Error::param(
+                "flute_length_mm",
+                format!(
+                    "{} mm must be at least 0 and shorter than the shank length {} mm",
+                    self.flute_length(),
+                    self.shank_length_mm
+                ),
+            ));
+        }
+        for (name, v) in [("lead_deg", self.lead_deg), ("tilt_deg", self.tilt_deg)] {
+            if !(v.is_finite() && v.abs() < 80.0) {
+                return Err(Error::param(
+                    name,
+                    format!("must be between -80° and 80°, got {v}"),
+                ));
+            }
+        }
+        if !(self.max_tilt_deg.is_finite() && (0.0..=90.0).contains(&self.max_tilt_deg)) {
+            return Err(Error::param(
+                "max_tilt_deg",
+                format!("must be between 0° and 90°, got {}", self.max_tilt_deg),
+            ));
+        }
+        if self.holder_radius_mm < self.shank_radius() {
+            return Err(Error::param(
+                "holder_radius_mm",
+                format!(
+                    "{} mm is smaller than the shank radius {} mm",
+                    self.holder_radius_mm,
+                    self.shank_radius()
+                ),
+            ));
+        }
         if self.scallop_mm >= self.tool_radius_mm {
             return Err(Error::param(
                 "scallop_mm",

@@ -1,6 +1,7 @@
 //! The tool path: ordered moves, each with its cutter-contact point, cutter-location point
 //! (the ball centre), tool axis, patch and iso-line, and the report computed from them.
 
+use super::corners::Crossfeed;
 use crate::geom::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -37,6 +38,25 @@ pub struct Move {
     pub line: u32,
 }
 
+/// How one patch was cut.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PatchRun {
+    pub patch: u32,
+    /// Corners 0: `(0,0)`, 1: `(1,0)`, 2: `(1,1)`, 3: `(0,1)` of the patch.
+    pub start_corner: u8,
+    pub finish_corner: u8,
+    pub crossfeed: Crossfeed,
+    pub passes: usize,
+    /// Scallop height the passes were spaced for (tuned below the request to finish at the
+    /// chosen corner) (mm).
+    pub scallop_used_mm: f64,
+    /// True if the tool comes down from the safe plane for this patch.
+    pub retract_before: bool,
+    /// Moves of this patch (indices into the path, inclusive).
+    pub first_move: usize,
+    pub last_move: usize,
+}
+
 /// A complete tool path for one ball-end tool.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Toolpath {
@@ -44,6 +64,8 @@ pub struct Toolpath {
     pub moves: Vec<Move>,
     /// Largest scallop predicted between adjacent lines by the step-over formula (mm).
     pub max_predicted_scallop_mm: f64,
+    /// The patches in the order cut.
+    pub runs: Vec<PatchRun>,
 }
 
 /// Summary of a tool path (keys as in the JSON report).
@@ -60,6 +82,10 @@ pub struct PlanReport {
     pub patches: usize,
     pub max_predicted_scallop_mm: f64,
     pub max_axis_step_deg: f64,
+    /// The patches in the order cut, with their corners and passes.
+    pub patch_order: Vec<PatchRun>,
+    /// Things the user should know (retractions the layout forced, ...).
+    pub notes: Vec<String>,
     /// Estimated machining time at the programmed feeds, rapids at `rapid_mm_min` (min).
     pub machining_time_min: f64,
     /// Wall time of planning (ms); filled by the caller, which owns the clock.
@@ -84,6 +110,8 @@ impl Toolpath {
             patches: 0,
             max_predicted_scallop_mm: self.max_predicted_scallop_mm,
             max_axis_step_deg: 0.0,
+            patch_order: self.runs.clone(),
+            notes: Vec::new(),
             machining_time_min: 0.0,
             plan_ms: 0.0,
         };

@@ -182,14 +182,34 @@ impl WasmModel {
                 None => true,
             }
         };
-        let path = isoparametric::plan_zigzag(&self.model, &opts, &mut cb).map_err(js_err)?;
-        let mut report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
+        let planned = isoparametric::plan(&self.model, &opts, &mut cb).map_err(js_err)?;
+        let mut report = planned.report(&opts);
         report.plan_ms = now_ms() - t0;
+        let path = planned.toolpath;
         let job = JobInfo {
             model: self.model.name.clone(),
             strategy: "isoparametric".into(),
         };
-        let gcode = machine::gcode_3axis(&path, &opts, &job).map_err(js_err)?;
+        // Three-axis G-code while the axis stays at +Z; a table-table A/C machine otherwise.
+        let three_axis = path
+            .moves
+            .iter()
+            .all(|m| m.tool_axis == crate::geom::Vector3::z());
+        let gcode = if three_axis {
+            machine::gcode_3axis(&path, &opts, &job)
+        } else {
+            machine::builtin("table-table-ac").and_then(|m| {
+                machine::post(
+                    &path,
+                    &opts,
+                    &job,
+                    &m,
+                    machine::Dialect::LinuxCnc,
+                    machine::Units::Mm,
+                )
+            })
+        }
+        .map_err(js_err)?;
         Ok(WasmPlan {
             path,
             report,

@@ -11,9 +11,12 @@ use tspath::plan::{isoparametric, Move, MoveKind, PlanOptions, Toolpath};
 
 /// Coarse options so that every sample plans in a moment.
 pub fn opts() -> PlanOptions {
-    PlanOptions::default()
+    let mut o = PlanOptions::default()
         .with_tool_radius(3.0)
-        .with_scallop(0.05)
+        .with_scallop(0.05);
+    // Planned three-axis (tool axis +Z); the five-axis variants are made from these paths.
+    o.max_tilt_deg = 0.0;
+    o
 }
 
 /// Coarse options a sample is planned (and posted) with, so that the machine tests stay quick
@@ -98,6 +101,7 @@ pub fn along_normals(path: &Toolpath) -> Toolpath {
         tool_radius_mm: path.tool_radius_mm,
         moves,
         max_predicted_scallop_mm: path.max_predicted_scallop_mm,
+        runs: path.runs.clone(),
     }
 }
 
@@ -133,6 +137,7 @@ pub fn sweep(axes: &[Vector3], r: f64, step_mm: f64, z_mm: f64) -> Toolpath {
         tool_radius_mm: r,
         moves,
         max_predicted_scallop_mm: 0.0,
+        runs: Vec::new(),
     }
 }
 

@@ -1,0 +1,461 @@
+//! Tool axis: the direction closest to +Z for which the shank and holder (cylinders above the
+//! cutting part) stay clear of the model, smoothed along the path, with optional lead and
+//! tilt.
+//!
+//! The ball itself cannot gouge where it touches (the side step keeps concave radii larger
+//! than the ball), and the fluted length above it cuts; the non-cutting shank above the
+//! flutes and the holder above the shank can hit walls elsewhere. The model is sampled densely
+//! (tessellation vertices and triangle centres) into a spatial grid; a candidate axis is clear
+//! when no sample lies inside the cylinders grown by the sampling gap. +Z is tested against a
+//! height map first (cheap); where it is not clear, tilts are searched around the circle,
+//! smallest first, then refined by bisection. Tilts are then ramped along the path so the
+//! axis turns gradually, keeping every axis clear.
+
+use super::toolpath::{MoveKind, Toolpath};
+use super::PlanOptions;
+use crate::error::{Error, Result};
+use crate::geom::{Point3, Vector3};
+use crate::model::Model;
+use std::collections::HashMap;
+
+/// Azimuths tried around +Z when the axis must tilt.
+const AZIMUTHS: usize = 24;
+/// First tilt tried and the step of the coarse search (degrees).
+const TILT_STEP_DEG: f64 = 2.0;
+/// Bisection steps refining the tilt.
+const TILT_BISECTIONS: usize = 6;
+/// How fast the tilt may change along the path (degrees per mm of travel).
+const RAMP_DEG_PER_MM: f64 = 10.0;
+
+/// Dense samples of the model's surface in a uniform grid, with a height map for vertical
+/// axes.
+pub struct Obstacles {
+    points: Vec<Point3>,
+    cell: f64,
+    grid: HashMap<(i32, i32, i32), Vec<u32>>,
+    /// Highest sample per column of the grid, dense over the model's x–y extent, at the
+    /// grid's cell size and at [`COARSE`] times it.
+    heights: HeightMap,
+    coarse: HeightMap,
+    /// Highest point of the model (mm).
+    top: f64,
+    /// Largest distance from any surface point to its nearest sample (mm): cylinders are
+    /// grown by this much.
+    pub gap_mm: f64,
+}
+
+impl Obstacles {
+    /// Samples the model for collision tests, no two neighbouring samples farther apart
+    /// than `spacing` (mm).
+    pub fn new(model: &Model, spacing: f64) -> Obstacles {
+        let size = model.surface.bbox().diagonal().max(1e-6);
+        let chordal = (0.25 * spacing).max(size * 2e-4);
+        let t = model.tessellate(chordal);
+        let p = |i: u32| {
+            let k = 3 * i as usize;
+            Point3::new(
+                t.positions[k] as f64,
+                t.positions[k + 1] as f64,
+                t.positions[k + 2] as f64,
+            )
+        };
+        let mut points: Vec<Point3> = (0..t.positions.len() as u32 / 3).map(p).collect();
+        let mut worst: f64 = 0.0;
+        for tri in t.indices.chunks(3) {
+            let (a, b, c) = (p(tri[0]), p(tri[1]), p(tri[2]));
+            let longest = (a - b).norm().max((b - c).norm()).max((c - a).norm());
+            // A barycentric lattice of n divisions per side: its spacing is longest / n.
+            let n = ((longest / spacing).ceil() as usize).max(1);
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let k = n - i - j;
+                    if i == n || j == n || k == n {
+                        continue; // the vertices are in already
+                    }
+                    let (x, y, z) = (
+                        i as f64 / n as f64,
+                        j as f64 / n as f64,
+                        k as f64 / n as f64,
+                    );
+                    points.push(Point3::from(a.coords * x + b.coords * y + c.coords * z));
+                }
+            }
+            worst = worst.max(longest / n as f64);
+        }
+        // Every point of a triangle is within 0.58 of the lattice spacing of a lattice point,
+        // and the surface within the chordal tolerance of the triangle.
+        let gap_mm = 0.58 * worst + chordal;
+        let cell = (size / GRID_CELLS).max(gap_mm);
+        let mut grid: HashMap<(i32, i32, i32), Vec<u32>> = HashMap::new();
+        let key = |x: f64| (x / cell).floor() as i32;
+        for (i, q) in points.iter().enumerate() {
+            grid.entry((key(q.x), key(q.y), key(q.z)))
+                .or_default()
+                .push(i as u32);
+        }
+        let heights = HeightMap::new(&points, cell);
+        let coarse = HeightMap::new(&points, cell * COARSE);
+        Obstacles {
+            points,
+            cell,
+            grid,
+            heights,
+            coarse,
+            top: model.surface.bbox().max[2],
+            gap_mm,
+        }
+    }
+
+    fn key(&self, x: f64) -> i32 {
+        (x / self.cell).floor() as i32
+    }
+
+    /// True if no sample within `radius` of `c` (in x–y) rises above `z`.
+    fn below(&self, c: &Point3, radius: f64, z: f64) -> bool {
+        let map = if radius > COARSE * self.cell {
+            &self.coarse
+        } else {
+            &self.heights
+        };
+        map.below(c, radius, z)
+    }
+
+    /// True if no sample lies inside the cylinder from `c + axis·a0` to `c + axis·a1` of
+    /// radius `rad` (all grown by the sampling gap).
+    fn cylinder_clear(&self, c: &Point3, axis: &Vector3, a0: f64, a1: f64, rad: f64) -> bool {
+        let g = self.gap_mm;
+        let rad = rad + g;
+        let (p0, p1) = (c + axis * a0, c + axis * a1);
+        // Entirely above the model: nothing to hit.
+        let lowest = p0.z.min(p1.z) - rad * (1.0 - axis.z * axis.z).max(0.0).sqrt();
+        if lowest > self.top + g {
+            return true;
+        }
+        let lo = [
+            p0.x.min(p1.x) - rad,
+            p0.y.min(p1.y) - rad,
+            p0.z.min(p1.z) - rad,
+        ];
+        let hi = [
+            p0.x.max(p1.x) + rad,
+            p0.y.max(p1.y) + rad,
+            p0.z.max(p1.z) + rad,
+        ];
+        let test = |q: &Point3| {
+            let d = q - c;
+            let axial = d.dot(axis);
+            axial > a0 - g && axial < a1 + g && (d - axis * axial).norm() < rad
+        };
+        let cells = ((self.key(hi[0]) - self.key(lo[0]) + 1) as f64)
+            * ((self.key(hi[1]) - self.key(lo[1]) + 1) as f64)
+            * ((self.key(hi[2]) - self.key(lo[2]) + 1) as f64);
+        if cells > self.points.len() as f64 {
+            return !self.points.iter().any(test);
+        }
+        for i in self.key(lo[0])..=self.key(hi[0]) {
+            for j in self.key(lo[1])..=self.key(hi[1]) {
+                for k in self.key(lo[2])..=self.key(hi[2]) {
+                    if let Some(list) = self.grid.get(&(i, j, k)) {
+                        if list.iter().any(|&pi| test(&self.points[pi as usize])) {
+                            return false;
+                        }
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// True if the shank (above the flutes) and the holder of a tool with its ball centre at
+    /// `c` along unit `axis` are clear of every sample.
+    pub fn clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
+        let (f, ls, lh) = (
+            opts.flute_length(),
+            opts.shank_length_mm,
+            opts.holder_length_mm,
+        );
+        if axis.z > 1.0 - 1e-15 {
+            // Vertical: the height map rules most points out at once.
+            let shank = self.below(c, opts.shank_radius() + self.gap_mm, c.z + f - self.gap_mm);
+            let holder = self.below(
+                c,
+                opts.holder_radius_mm + self.gap_mm,
+                c.z + ls - self.gap_mm,
+            );
+            if shank && holder {
+                return true;
+            }
+        }
+        self.cylinder_clear(c, axis, f, ls, opts.shank_radius())
+            && self.cylinder_clear(c, axis, ls, ls + lh, opts.holder_radius_mm)
+    }
+}
+
+/// Ratio of the coarse height map's cell to the fine one's.
+const COARSE: f64 = 8.0;
+
+/// Highest sample in each cell of a dense x–y grid.
+struct HeightMap {
+    cell: f64,
+    origin: [f64; 2],
+    nx: usize,
+    ny: usize,
+    max_z: Vec<f64>,
+}
+
+impl HeightMap {
+    fn new(points: &[Point3], cell: f64) -> HeightMap {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in points {
+            lo = [lo[0].min(p.x), lo[1].min(p.y)];
+            hi = [hi[0].max(p.x), hi[1].max(p.y)];
+        }
+        let nx = (((hi[0] - lo[0]) / cell).floor() as usize + 1).max(1);
+        let ny = (((hi[1] - lo[1]) / cell).floor() as usize + 1).max(1);
+        let mut max_z = vec![f64::NEG_INFINITY; nx * ny];
+        for p in points {
+            let i = (((p.x - lo[0]) / cell) as usize).min(nx - 1);
+            let j = (((p.y - lo[1]) / cell) as usize).min(ny - 1);
+            max_z[j * nx + i] = max_z[j * nx + i].max(p.z);
+        }
+        HeightMap {
+            cell,
+            origin: lo,
+            nx,
+            ny,
+            max_z,
+        }
+    }
+
+    fn below(&self, c: &Point3, radius: f64, z: f64) -> bool {
+        let idx =
+            |x: f64, o: f64, n: usize| (((x - o) / self.cell).floor().max(0.0) as usize).min(n - 1);
+        let (i0, i1) = (
+            idx(c.x - radius, self.origin[0], self.nx),
+            idx(c.x + radius, self.origin[0], self.nx),
+        );
+        let (j0, j1) = (
+            idx(c.y - radius, self.origin[1], self.ny),
+            idx(c.y + radius, self.origin[1], self.ny),
+        );
+        (j0..=j1).all(|j| {
+            self.max_z[j * self.nx + i0..=j * self.nx + i1]
+                .iter()
+                .all(|&h| h <= z)
+        })
+    }
+}
+
+/// Obstacle samples along the model's diagonal, at the least.
+const OBSTACLE_SAMPLES: f64 = 300.0;
+/// Grid cells along the model's diagonal in the obstacle index.
+const GRID_CELLS: f64 = 64.0;
+
+/// Unit axis tilted `theta` (radians) from +Z towards azimuth `phi`.
+fn tilted(theta: f64, phi: f64) -> Vector3 {
+    Vector3::new(
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    )
+}
+
+/// Tilt (radians) and azimuth of a unit axis.
+fn tilt_of(a: &Vector3) -> (f64, f64) {
+    (a.z.clamp(-1.0, 1.0).acos(), a.y.atan2(a.x))
+}
+
+/// The axis closest to +Z that is clear at `c`, preferring azimuths near `prev`.
+fn clear_axis(obs: &Obstacles, c: &Point3, opts: &PlanOptions, prev: &Vector3) -> Option<Vector3> {
+    let max = opts.max_tilt_deg.to_radians();
+    let step = TILT_STEP_DEG.to_radians();
+    let mut theta = step;
+    while theta <= max + 1e-12 {
+        let mut best: Option<(f64, f64)> = None;
+        for k in 0..AZIMUTHS {
+            let phi = k as f64 * std::f64::consts::TAU / AZIMUTHS as f64;
+            let a = tilted(theta, phi);
+            if obs.clear(c, &a, opts) {
+                let score = -a.dot(prev);
+                if best.is_none_or(|b| score < b.0) {
+                    best = Some((score, phi));
+                }
+            }
+        }
+        if let Some((_, phi)) = best {
+            // Refine the tilt between the last blocked and this clear one.
+            let (mut lo, mut hi) = (theta - step, theta);
+            for _ in 0..TILT_BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                if mid > 0.0 && obs.clear(c, &tilted(mid, phi), opts) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return Some(tilted(hi, phi));
+        }
+        theta += step;
+    }
+    None
+}
+
+/// Rotates `v` about unit `k` by `angle` (Rodrigues).
+fn rotate(v: &Vector3, k: &Vector3, angle: f64) -> Vector3 {
+    let (s, c) = angle.sin_cos();
+    v * c + k.cross(v) * s + k * (k.dot(v) * (1.0 - c))
+}
+
+/// What the axis assignment found.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AxisStats {
+    /// Points where the axis left +Z to clear the shank or holder.
+    pub tilted: usize,
+    /// Points where no axis within the allowed tilt is clear (three-axis: where +Z hits).
+    pub blocked: usize,
+    /// The first of those, for the report.
+    pub first_blocked: Option<Point3>,
+}
+
+/// Sets the tool axis of every move of `path`. With `max_tilt_deg` 0 (three-axis) the axis
+/// stays +Z and collisions are counted; otherwise a point where no allowed axis is clear is
+/// an error.
+pub fn assign(
+    model: &Model,
+    path: &mut Toolpath,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<AxisStats> {
+    let r = path.tool_radius_mm;
+    let spacing =
+        (0.25 * opts.shank_radius()).min(model.surface.bbox().diagonal() / OBSTACLE_SAMPLES);
+    let obs = Obstacles::new(model, spacing);
+    let n = path.moves.len();
+    let on_surface = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
+    let mut axes: Vec<Vector3> = vec![Vector3::z(); n];
+    let mut prev = Vector3::z();
+    let mut stats = AxisStats::default();
+    for i in 0..n {
+        let m = path.moves[i];
+        if !on_surface(m.kind) {
+            continue;
+        }
+        let c = m.cl_point;
+        let mut axis = Vector3::z();
+        if opts.lead_deg != 0.0 || opts.tilt_deg != 0.0 {
+            // Lead and tilt are taken from the surface normal in the feed frame.
+            let normal = (m.cl_point - m.cc_point) / r;
+            let next = path
+                .moves
+                .get(i + 1)
+                .filter(|x| on_surface(x.kind))
+                .map(|x| x.cc_point);
+            let before = i
+                .checked_sub(1)
+                .map(|j| path.moves[j])
+                .filter(|x| on_surface(x.kind))
+                .map(|x| x.cc_point);
+            let feed = match (before, next) {
+                (_, Some(q)) => q - m.cc_point,
+                (Some(p), None) => m.cc_point - p,
+                _ => Vector3::x(),
+            };
+            let feed = (feed - normal * feed.dot(&normal))
+                .try_normalize(1e-12)
+                .unwrap_or_else(Vector3::x);
+            let side = normal.cross(&feed);
+            let a = rotate(&normal, &side, opts.lead_deg.to_radians());
+            let a = rotate(&a, &feed, opts.tilt_deg.to_radians());
+            if obs.clear(&c, &a, opts) {
+                axis = a;
+            }
+        }
+        if axis == Vector3::z() && !obs.clear(&c, &axis, opts) {
+            match clear_axis(&obs, &c, opts, &prev) {
+                Some(a) => {
+                    axis = a;
+                    stats.tilted += 1;
+                }
+                None => {
+                    stats.blocked += 1;
+                    stats.first_blocked.get_or_insert(c);
+                }
+            }
+        }
+        axes[i] = axis;
+        prev = axis;
+        if i % 512 == 0 && !progress(i as f64 / n as f64) {
+            return Err(Error::Cancelled);
+        }
+    }
+    ramp(path, &mut axes, &obs, opts);
+    // Moves off the surface keep the axis of the nearest cut.
+    let mut last = None;
+    for i in 0..n {
+        if on_surface(path.moves[i].kind) {
+            last = Some(axes[i]);
+        } else if let Some(a) = last {
+            axes[i] = a;
+        }
+    }
+    let mut next = None;
+    for i in (0..n).rev() {
+        if on_surface(path.moves[i].kind) {
+            next = Some(axes[i]);
+        } else if path.moves[i].kind == MoveKind::Rapid {
+            if let Some(a) = next {
+                axes[i] = a;
+            }
+        }
+    }
+    for (m, a) in path.moves.iter_mut().zip(&axes) {
+        m.tool_axis = *a;
+    }
+    if stats.blocked > 0 && opts.max_tilt_deg > 0.0 {
+        let p = stats.first_blocked.unwrap_or_else(Point3::origin);
+        return Err(Error::Degenerate {
+            location: format!(
+                "{} points of the path, the first at ball centre ({:.3}, {:.3}, {:.3}) mm",
+                stats.blocked, p.x, p.y, p.z
+            ),
+            message: format!(
+                "the shank or holder hits the model for every tool axis within {}° of +Z: use a longer shank, a smaller holder or allow more tilt",
+                opts.max_tilt_deg
+            ),
+        });
+    }
+    progress(1.0);
+    Ok(stats)
+}
+
+/// Spreads tilts along the path so the axis turns gradually: each point's tilt is raised to
+/// at least its neighbours' tilt minus [`RAMP_DEG_PER_MM`] per mm of travel (same azimuth
+/// as the neighbour), wherever that axis is clear too.
+fn ramp(path: &Toolpath, axes: &mut [Vector3], obs: &Obstacles, opts: &PlanOptions) {
+    let n = axes.len();
+    let rate = RAMP_DEG_PER_MM.to_radians();
+    let cuts = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
+    for pass in 0..2 {
+        let idx: Vec<usize> = if pass == 0 {
+            (1..n).collect()
+        } else {
+            (0..n.saturating_sub(1)).rev().collect()
+        };
+        for i in idx {
+            let j = if pass == 0 { i - 1 } else { i + 1 };
+            if !cuts(path.moves[i].kind) || !cuts(path.moves[j].kind) {
+                continue;
+            }
+            let d = (path.moves[i].cl_point - path.moves[j].cl_point).norm();
+            let (tj, pj) = tilt_of(&axes[j]);
+            let (ti, _) = tilt_of(&axes[i]);
+            let want = tj - rate * d;
+            if want > ti + 1e-9 {
+                let cand = tilted(want, pj);
+                if obs.clear(&path.moves[i].cl_point, &cand, opts) {
+                    axes[i] = cand;
+                }
+            }
+        }
+    }
+}
