@@ -629,3 +629,69 @@ fn waves() -> Result<TMesh> {
         &[(1, 4), (10, 8)],
     )
 }
+
+/// A piece of a cylinder of radius `radius` (mm) about the y axis, spanning `angle_deg`
+/// (< 180°) symmetrically about +Z and `length` (mm) along y: one rational bicubic patch,
+/// exactly on the cylinder. `u` runs round the circle, `v` along the axis. With `inside`
+/// the normals point to the axis (a concave trough seen from above, when placed below the
+/// axis: the patch is then the lower part of the circle).
+pub fn cylinder_patch(radius: f64, length: f64, angle_deg: f64, inside: bool) -> Result<TMesh> {
+    let a = 0.5 * angle_deg.to_radians();
+    let arc_pts = arc(a);
+    // The arc in the x–z plane around +Z (outside) or around −Z (inside, lower half).
+    let row: Vec<Vector4> = arc_pts
+        .iter()
+        .map(|&([c, s], w)| {
+            let (x, z) = if inside {
+                (s * radius, -c * radius)
+            } else {
+                (s * radius, c * radius)
+            };
+            Vector4::new(w * x, 0.0, w * z, w)
+        })
+        .collect();
+    let cubic = elevate([row[0], row[1], row[2]]);
+    let mut points = Vec::with_capacity(16);
+    for j in 0..4 {
+        let y = length * j as f64 / 3.0 - 0.5 * length;
+        for h in &cubic {
+            points.push(ControlPoint {
+                point: Point3::new(h.x / h.w, y, h.z / h.w),
+                weight: h.w,
+            });
+        }
+    }
+    TMesh::from_grid(
+        points,
+        4,
+        4,
+        &[0.0, 1.0, 0.0],
+        &[0.0, 1.0, 0.0],
+        Scheme::TSpline,
+    )
+}
+
+/// A flat square patch of side `side` (mm) in the plane z = 0, normal +Z.
+pub fn plane_patch(side: f64) -> Result<TMesh> {
+    let mut points = Vec::with_capacity(16);
+    for j in 0..4 {
+        for i in 0..4 {
+            points.push(ControlPoint {
+                point: Point3::new(
+                    side * (i as f64 / 3.0 - 0.5),
+                    side * (j as f64 / 3.0 - 0.5),
+                    0.0,
+                ),
+                weight: 1.0,
+            });
+        }
+    }
+    TMesh::from_grid(
+        points,
+        4,
+        4,
+        &[0.0, 1.0, 0.0],
+        &[0.0, 1.0, 0.0],
+        Scheme::TSpline,
+    )
+}

@@ -8,8 +8,9 @@
 //! (tessellation vertices and triangle centres) into a spatial grid; a candidate axis is clear
 //! when no sample lies inside the cylinders grown by the sampling gap. +Z is tested against a
 //! height map first (cheap); where it is not clear, tilts are searched around the circle,
-//! smallest first, then refined by bisection. Tilts are then ramped along the path so the
-//! axis turns gradually, keeping every axis clear.
+//! smallest first (preferring the azimuth of the previous point's axis), then refined by
+//! bisection. The least clear tilt changes continuously as the tool nears a wall, so the
+//! axis turns gradually without smoothing, and it is +Z wherever +Z is clear.
 
 use super::toolpath::{MoveKind, Toolpath};
 use super::PlanOptions;
@@ -18,14 +19,14 @@ use crate::geom::{Point3, Vector3};
 use crate::model::Model;
 use std::collections::HashMap;
 
-/// Azimuths tried around +Z when the axis must tilt.
-const AZIMUTHS: usize = 24;
-/// First tilt tried and the step of the coarse search (degrees).
-const TILT_STEP_DEG: f64 = 2.0;
-/// Bisection steps refining the tilt.
+/// Azimuths tried around +Z when the usual ones fail.
+const AZIMUTHS: usize = 12;
+/// Step of the coarse tilt search (degrees).
+const TILT_STEP_DEG: f64 = 5.0;
+/// Bisection steps refining the tilt (5° / 2^6 ≈ 0.08°).
 const TILT_BISECTIONS: usize = 6;
-/// How fast the tilt may change along the path (degrees per mm of travel).
-const RAMP_DEG_PER_MM: f64 = 10.0;
+/// Azimuths either side of "away from the obstacle" also tried (radians, 30°).
+const SIDE_AZIMUTH: f64 = std::f64::consts::FRAC_PI_6;
 
 /// Dense samples of the model's surface in a uniform grid, with a height map for vertical
 /// axes.
@@ -120,16 +121,23 @@ impl Obstacles {
         map.below(c, radius, z)
     }
 
-    /// True if no sample lies inside the cylinder from `c + axis·a0` to `c + axis·a1` of
-    /// radius `rad` (all grown by the sampling gap).
-    fn cylinder_clear(&self, c: &Point3, axis: &Vector3, a0: f64, a1: f64, rad: f64) -> bool {
+    /// A sample inside the cylinder from `c + axis·a0` to `c + axis·a1` of radius `rad` (all
+    /// grown by the sampling gap), if there is one.
+    fn cylinder_hit(
+        &self,
+        c: &Point3,
+        axis: &Vector3,
+        a0: f64,
+        a1: f64,
+        rad: f64,
+    ) -> Option<Point3> {
         let g = self.gap_mm;
         let rad = rad + g;
         let (p0, p1) = (c + axis * a0, c + axis * a1);
         // Entirely above the model: nothing to hit.
         let lowest = p0.z.min(p1.z) - rad * (1.0 - axis.z * axis.z).max(0.0).sqrt();
         if lowest > self.top + g {
-            return true;
+            return None;
         }
         let lo = [
             p0.x.min(p1.x) - rad,
@@ -139,10 +147,10 @@ impl Obstacles {
         let hi = [
             p0.x.max(p1.x) + rad,
             p0.y.max(p1.y) + rad,
-            p0.z.max(p1.z) + rad,
+            (p0.z.max(p1.z) + rad).min(self.top + g),
         ];
-        let test = |q: &Point3| {
-            let d = q - c;
+        let test = |q: &&Point3| {
+            let d = *q - c;
             let axial = d.dot(axis);
             axial > a0 - g && axial < a1 + g && (d - axis * axial).norm() < rad
         };
@@ -150,25 +158,26 @@ impl Obstacles {
             * ((self.key(hi[1]) - self.key(lo[1]) + 1) as f64)
             * ((self.key(hi[2]) - self.key(lo[2]) + 1) as f64);
         if cells > self.points.len() as f64 {
-            return !self.points.iter().any(test);
+            return self.points.iter().find(test).copied();
         }
         for i in self.key(lo[0])..=self.key(hi[0]) {
             for j in self.key(lo[1])..=self.key(hi[1]) {
                 for k in self.key(lo[2])..=self.key(hi[2]) {
                     if let Some(list) = self.grid.get(&(i, j, k)) {
-                        if list.iter().any(|&pi| test(&self.points[pi as usize])) {
-                            return false;
+                        if let Some(p) = list.iter().map(|&pi| &self.points[pi as usize]).find(test)
+                        {
+                            return Some(*p);
                         }
                     }
                 }
             }
         }
-        true
+        None
     }
 
-    /// True if the shank (above the flutes) and the holder of a tool with its ball centre at
-    /// `c` along unit `axis` are clear of every sample.
-    pub fn clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
+    /// A sample inside the shank (above the flutes) or the holder of a tool with its ball
+    /// centre at `c` along unit `axis`, if there is one.
+    pub fn hit(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> Option<Point3> {
         let (f, ls, lh) = (
             opts.flute_length(),
             opts.shank_length_mm,
@@ -183,11 +192,16 @@ impl Obstacles {
                 c.z + ls - self.gap_mm,
             );
             if shank && holder {
-                return true;
+                return None;
             }
         }
-        self.cylinder_clear(c, axis, f, ls, opts.shank_radius())
-            && self.cylinder_clear(c, axis, ls, ls + lh, opts.holder_radius_mm)
+        self.cylinder_hit(c, axis, f, ls, opts.shank_radius())
+            .or_else(|| self.cylinder_hit(c, axis, ls, ls + lh, opts.holder_radius_mm))
+    }
+
+    /// True if the shank and holder at `c` along `axis` are clear of every sample.
+    pub fn clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
+        self.hit(c, axis, opts).is_none()
     }
 }
 
@@ -247,7 +261,7 @@ impl HeightMap {
 }
 
 /// Obstacle samples along the model's diagonal, at the least.
-const OBSTACLE_SAMPLES: f64 = 300.0;
+const OBSTACLE_SAMPLES: f64 = 150.0;
 /// Grid cells along the model's diagonal in the obstacle index.
 const GRID_CELLS: f64 = 64.0;
 
@@ -260,45 +274,71 @@ fn tilted(theta: f64, phi: f64) -> Vector3 {
     )
 }
 
-/// Tilt (radians) and azimuth of a unit axis.
-fn tilt_of(a: &Vector3) -> (f64, f64) {
-    (a.z.clamp(-1.0, 1.0).acos(), a.y.atan2(a.x))
-}
-
-/// The axis closest to +Z that is clear at `c`, preferring azimuths near `prev`.
-fn clear_axis(obs: &Obstacles, c: &Point3, opts: &PlanOptions, prev: &Vector3) -> Option<Vector3> {
+/// The least tilt (radians) along azimuth `phi` at which the tool is clear: the first clear
+/// one in steps of [`TILT_STEP_DEG`] up to the largest allowed, refined by bisection.
+fn least_tilt(obs: &Obstacles, c: &Point3, opts: &PlanOptions, phi: f64) -> Option<f64> {
     let max = opts.max_tilt_deg.to_radians();
     let step = TILT_STEP_DEG.to_radians();
-    let mut theta = step;
-    while theta <= max + 1e-12 {
-        let mut best: Option<(f64, f64)> = None;
-        for k in 0..AZIMUTHS {
-            let phi = k as f64 * std::f64::consts::TAU / AZIMUTHS as f64;
-            let a = tilted(theta, phi);
-            if obs.clear(c, &a, opts) {
-                let score = -a.dot(prev);
-                if best.is_none_or(|b| score < b.0) {
-                    best = Some((score, phi));
-                }
-            }
+    let mut hi = step.min(max);
+    loop {
+        if obs.clear(c, &tilted(hi, phi), opts) {
+            break;
         }
-        if let Some((_, phi)) = best {
-            // Refine the tilt between the last blocked and this clear one.
-            let (mut lo, mut hi) = (theta - step, theta);
-            for _ in 0..TILT_BISECTIONS {
-                let mid = 0.5 * (lo + hi);
-                if mid > 0.0 && obs.clear(c, &tilted(mid, phi), opts) {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            return Some(tilted(hi, phi));
+        if hi >= max {
+            return None;
         }
-        theta += step;
+        hi = (hi + step).min(max);
     }
-    None
+    let mut lo = (hi - step).max(0.0);
+    for _ in 0..TILT_BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if obs.clear(c, &tilted(mid, phi), opts) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
 }
+
+/// A clear axis close to +Z at `c`: the least tilt along the previous point's azimuth, away
+/// from the sample the vertical tool hits, and a little either side of that, the least of
+/// them; failing those, around the circle.
+fn clear_axis(
+    obs: &Obstacles,
+    c: &Point3,
+    opts: &PlanOptions,
+    prev: &Vector3,
+    hit: &Point3,
+) -> Option<Vector3> {
+    let away = (c.y - hit.y).atan2(c.x - hit.x);
+    let best = [away, away + SIDE_AZIMUTH, away - SIDE_AZIMUTH]
+        .iter()
+        .filter_map(|&phi| least_tilt(obs, c, opts, phi).map(|t| (t, phi)))
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    // Keep turning the way the previous point did unless another way needs clearly less
+    // tilt: the axis then does not swing round between neighbouring points.
+    let kept = (prev.z < 1.0 - 1e-12)
+        .then(|| {
+            let phi = prev.y.atan2(prev.x);
+            least_tilt(obs, c, opts, phi).map(|t| (t, phi))
+        })
+        .flatten();
+    let chosen = match (kept, best) {
+        (Some(k), Some(b)) if k.0 <= b.0 + KEEP_AZIMUTH_SLACK.to_radians() => Some(k),
+        (k, b) => b.or(k),
+    }
+    .or_else(|| {
+        (0..AZIMUTHS).find_map(|k| {
+            let phi = away + k as f64 * std::f64::consts::TAU / AZIMUTHS as f64;
+            least_tilt(obs, c, opts, phi).map(|t| (t, phi))
+        })
+    })?;
+    Some(tilted(chosen.0, chosen.1))
+}
+
+/// Extra tilt accepted to keep the previous point's azimuth (degrees).
+const KEEP_AZIMUTH_SLACK: f64 = 5.0;
 
 /// Rotates `v` about unit `k` by `angle` (Rodrigues).
 fn rotate(v: &Vector3, k: &Vector3, angle: f64) -> Vector3 {
@@ -370,8 +410,16 @@ pub fn assign(
                 axis = a;
             }
         }
-        if axis == Vector3::z() && !obs.clear(&c, &axis, opts) {
-            match clear_axis(&obs, &c, opts, &prev) {
+        let vertical_hit = if axis == Vector3::z() {
+            obs.hit(&c, &axis, opts)
+        } else {
+            None
+        };
+        if let Some(h) = vertical_hit {
+            match (opts.max_tilt_deg > 0.0)
+                .then(|| clear_axis(&obs, &c, opts, &prev, &h))
+                .flatten()
+            {
                 Some(a) => {
                     axis = a;
                     stats.tilted += 1;
@@ -388,7 +436,6 @@ pub fn assign(
             return Err(Error::Cancelled);
         }
     }
-    ramp(path, &mut axes, &obs, opts);
     // Moves off the surface keep the axis of the nearest cut.
     let mut last = None;
     for i in 0..n {
@@ -426,36 +473,4 @@ pub fn assign(
     }
     progress(1.0);
     Ok(stats)
-}
-
-/// Spreads tilts along the path so the axis turns gradually: each point's tilt is raised to
-/// at least its neighbours' tilt minus [`RAMP_DEG_PER_MM`] per mm of travel (same azimuth
-/// as the neighbour), wherever that axis is clear too.
-fn ramp(path: &Toolpath, axes: &mut [Vector3], obs: &Obstacles, opts: &PlanOptions) {
-    let n = axes.len();
-    let rate = RAMP_DEG_PER_MM.to_radians();
-    let cuts = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
-    for pass in 0..2 {
-        let idx: Vec<usize> = if pass == 0 {
-            (1..n).collect()
-        } else {
-            (0..n.saturating_sub(1)).rev().collect()
-        };
-        for i in idx {
-            let j = if pass == 0 { i - 1 } else { i + 1 };
-            if !cuts(path.moves[i].kind) || !cuts(path.moves[j].kind) {
-                continue;
-            }
-            let d = (path.moves[i].cl_point - path.moves[j].cl_point).norm();
-            let (tj, pj) = tilt_of(&axes[j]);
-            let (ti, _) = tilt_of(&axes[i]);
-            let want = tj - rate * d;
-            if want > ti + 1e-9 {
-                let cand = tilted(want, pj);
-                if obs.clear(&path.moves[i].cl_point, &cand, opts) {
-                    axes[i] = cand;
-                }
-            }
-        }
-    }
 }

@@ -492,6 +492,8 @@ pub fn plan(
     let (transits, forced) = corners::select(&order, &ids, &preferred, None);
     let safe_z = model.surface.bbox().max[2] + 2.0 * r + opts.clearance_mm;
     let mut moves: Vec<Move> = Vec::new();
+    // Patch parameters of each move, filled as moves are added.
+    let mut params: Vec<[f64; 2]> = Vec::new();
     let mut runs: Vec<PatchRun> = Vec::new();
     let mut worst: f64 = 0.0;
     for (k, tr) in transits.iter().enumerate() {
@@ -525,6 +527,7 @@ pub fn plan(
             for (j, &t) in ts.iter().enumerate() {
                 let (cc, n) = pass_point(view, dir, t, w)?;
                 let cl = cc + n * r;
+                let (pu, pv) = at(dir, t, w);
                 let mv = |kind| Move {
                     kind,
                     cc_point: cc,
@@ -542,21 +545,24 @@ pub fn plan(
                                     cl_point: Point3::new(last.cl_point.x, last.cl_point.y, safe_z),
                                     ..last
                                 });
+                                params.push(*params.last().unwrap_or(&[pu, pv]));
                             }
                             moves.push(Move {
                                 cl_point: Point3::new(cl.x, cl.y, safe_z),
                                 ..mv(MoveKind::Rapid)
                             });
                             moves.push(mv(MoveKind::Plunge));
+                            params.extend([[pu, pv], [pu, pv]]);
                         } else {
                             // Transit from the previous patch's finishing corner.
                             moves.push(mv(MoveKind::Link));
+                            params.push([pu, pv]);
                         }
                     } else {
                         link_between(
                             view,
                             dir,
-                            &mut moves,
+                            (&mut moves, &mut params),
                             ws[li - 1],
                             w,
                             t,
@@ -566,9 +572,11 @@ pub fn plan(
                             li,
                         )?;
                         moves.push(mv(MoveKind::Link));
+                        params.push([pu, pv]);
                     }
                 } else {
                     moves.push(mv(MoveKind::Feed));
+                    params.push([pu, pv]);
                 }
             }
             let frac = (k as f64 + (li + 1) as f64 / nlines as f64) / transits.len() as f64;
@@ -594,12 +602,14 @@ pub fn plan(
             cl_point: Point3::new(last.cl_point.x, last.cl_point.y, safe_z),
             ..last
         });
+        params.push(*params.last().unwrap_or(&[0.0, 0.0]));
     }
     let mut toolpath = Toolpath {
         tool_radius_mm: r,
         moves,
         max_predicted_scallop_mm: worst,
         runs,
+        params,
     };
     let axes = axis::assign(model, &mut toolpath, opts, &mut |f| progress(0.8 + 0.2 * f))?;
     Ok(Planned {
@@ -616,7 +626,7 @@ pub fn plan(
 fn link_between(
     s: &dyn ParamSurface,
     dir: FeedDir,
-    moves: &mut Vec<Move>,
+    (moves, params): (&mut Vec<Move>, &mut Vec<[f64; 2]>),
     w0: f64,
     w1: f64,
     t: f64,
@@ -666,6 +676,8 @@ fn link_between(
             patch: patch as u32,
             line: line as u32,
         });
+        let (u, v) = at(other, w, t);
+        params.push([u, v]);
     }
     Ok(())
 }

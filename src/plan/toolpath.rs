@@ -58,7 +58,7 @@ pub struct PatchRun {
 }
 
 /// A complete tool path for one ball-end tool.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Toolpath {
     pub tool_radius_mm: f64,
     pub moves: Vec<Move>,
@@ -66,6 +66,9 @@ pub struct Toolpath {
     pub max_predicted_scallop_mm: f64,
     /// The patches in the order cut.
     pub runs: Vec<PatchRun>,
+    /// Patch parameters `(u, v)` of each move's contact point (empty for paths not made
+    /// by a planner).
+    pub params: Vec<[f64; 2]>,
 }
 
 /// Summary of a tool path (keys as in the JSON report).
@@ -96,6 +99,15 @@ pub struct PlanReport {
 pub const RAPID_MM_MIN: f64 = 5000.0;
 
 impl Toolpath {
+    /// A path of `moves` for a ball of radius `tool_radius_mm`, without planner details.
+    pub fn new(tool_radius_mm: f64, moves: Vec<Move>) -> Self {
+        Toolpath {
+            tool_radius_mm,
+            moves,
+            ..Default::default()
+        }
+    }
+
     /// Lengths, counts and time estimate. `feed` and `plunge_feed` in mm/min.
     pub fn report(&self, strategy: &str, feed: f64, plunge_feed: f64) -> PlanReport {
         let mut r = PlanReport {

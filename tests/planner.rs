@@ -1,0 +1,468 @@
+//! The patch-ordered non-retraction isoparametric planner (Shang et al. 2020): paths without
+//! retractions on the sample models, zig-zags ending at their chosen corners, chords within
+//! the tolerance, the patch order against brute force, transit corners through a corner
+//! connection, side steps against eq. 5 on exact planes and cylinders, and collision-free
+//! tool axes checked by an independent distance test.
+
+use tspath::geom::{Point3, Vector3};
+use tspath::model::samples;
+use tspath::plan::corners::{self, corner_uv, Crossfeed};
+use tspath::plan::isoparametric::{self, corner_ids, patch_costs, ParamSurface, PatchView};
+use tspath::plan::order::{self, CostMatrix};
+use tspath::plan::{MoveKind, PlanOptions, Toolpath};
+use tspath::Model;
+
+fn paper() -> PlanOptions {
+    PlanOptions::default()
+        .with_tool_radius(0.5)
+        .with_scallop(0.005)
+        .with_chordal(0.001)
+}
+
+/// Checks the path's structure on `model`; returns (CL points, retractions).
+fn check_structure(name: &str, model: &Model, path: &Toolpath, opts: &PlanOptions) {
+    let report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
+    assert_eq!(report.retractions, 0, "{name}: retractions");
+    // Every patch once.
+    let mut seen: Vec<u32> = path.runs.iter().map(|r| r.patch).collect();
+    seen.sort_unstable();
+    assert_eq!(
+        seen,
+        (0..model.layout.len() as u32).collect::<Vec<_>>(),
+        "{name}: every patch once"
+    );
+    let size = model.surface.bbox().diagonal();
+    for (k, run) in path.runs.iter().enumerate() {
+        let view = PatchView {
+            index: run.patch as usize,
+            patch: &model.layout.patches[run.patch as usize],
+            surface: &model.surface,
+        };
+        let corner = |c: u8| {
+            let (u, v) = corner_uv(c);
+            view.subs(u as f64, v as f64)
+        };
+        let first = path.moves[run.first_move];
+        let last = path.moves[run.last_move];
+        assert!(
+            (first.cc_point - corner(run.start_corner)).norm() < 1e-9 * size,
+            "{name}: run {k} starts at its corner"
+        );
+        assert!(
+            (last.cc_point - corner(run.finish_corner)).norm() < 1e-9 * size,
+            "{name}: run {k} ends at its corner"
+        );
+        assert_ne!(run.start_corner, run.finish_corner);
+        if k + 1 < path.runs.len() {
+            // Joined at the shared transit corner: the next run starts where this one ended.
+            let next = path.moves[path.runs[k + 1].first_move];
+            assert!(
+                (next.cc_point - last.cc_point).norm() < 1e-9 * size,
+                "{name}: transit {k}"
+            );
+            assert!(!path.runs[k + 1].retract_before);
+        }
+        assert!(
+            run.scallop_used_mm <= opts.scallop_mm && run.scallop_used_mm > 0.5 * opts.scallop_mm
+        );
+    }
+    // Chords within the tolerance: the surface half-way (in parameters) between consecutive
+    // cutting points lies within the chordal tolerance of the chord.
+    let mut worst: f64 = 0.0;
+    for i in 1..path.moves.len() {
+        let (a, b) = (&path.moves[i - 1], &path.moves[i]);
+        if b.kind != MoveKind::Feed || a.patch != b.patch || a.line != b.line {
+            continue;
+        }
+        let (pa, pb) = (path.params[i - 1], path.params[i]);
+        let patch = &model.layout.patches[b.patch as usize];
+        let mid = patch.subs(&model.surface, 0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]));
+        let ab = b.cc_point - a.cc_point;
+        let t = ((mid - a.cc_point).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+        worst = worst.max((mid - (a.cc_point + ab * t)).norm());
+    }
+    println!(
+        "{name}: {} CL points, {} patches, max predicted scallop {:.5} mm, worst mid-chord deviation {:.5} mm, length {:.1} mm",
+        report.cl_points, report.patches, report.max_predicted_scallop_mm, worst, report.length_mm
+    );
+    assert!(
+        worst <= opts.chordal_mm * (1.0 + 1e-6),
+        "{name}: chord deviation {worst}"
+    );
+    assert!(
+        report.max_predicted_scallop_mm <= opts.scallop_mm * (1.0 + 1e-9),
+        "{name}: predicted scallop"
+    );
+}
+
+#[test]
+fn keycaps_at_the_papers_settings_need_no_retraction() {
+    for name in ["keycap-convex", "keycap-concave"] {
+        let m = samples::load_sample(name).unwrap();
+        let planned = isoparametric::plan(&m, &paper(), &mut |_| true).unwrap();
+        assert_eq!(planned.forced_retractions, 0);
+        check_structure(name, &m, &planned.toolpath, &paper());
+    }
+}
+
+#[test]
+fn head_and_t_junction_sample_need_no_retraction() {
+    // The closed head is planned three-axis: its underside cannot be reached from above,
+    // which the report says; the path itself is still one piece.
+    let mut opts = PlanOptions::default()
+        .with_tool_radius(2.0)
+        .with_scallop(0.05)
+        .with_chordal(0.005);
+    opts.max_tilt_deg = 0.0;
+    let head = samples::load_sample("head").unwrap();
+    let planned = isoparametric::plan(&head, &opts, &mut |_| true).unwrap();
+    check_structure("head", &head, &planned.toolpath, &opts);
+    assert!(
+        planned.axes.blocked > 0,
+        "the holder hits the head from below"
+    );
+    assert!(planned
+        .report(&opts)
+        .notes
+        .iter()
+        .any(|n| n.contains("would hit")));
+    let t = samples::load_sample("tjunction").unwrap();
+    let opts = PlanOptions::default()
+        .with_tool_radius(1.0)
+        .with_scallop(0.01);
+    let planned = isoparametric::plan(&t, &opts, &mut |_| true).unwrap();
+    check_structure("tjunction", &t, &planned.toolpath, &opts);
+}
+
+fn brute_force(m: &CostMatrix, start: usize, finish: Option<usize>) -> f64 {
+    fn rec(
+        m: &CostMatrix,
+        order: &mut Vec<usize>,
+        used: &mut Vec<bool>,
+        finish: Option<usize>,
+        best: &mut f64,
+    ) {
+        if order.len() == m.n {
+            if finish.is_none_or(|f| *order.last().unwrap() == f) {
+                *best = best.min(m.path_cost(order));
+            }
+            return;
+        }
+        for j in 0..m.n {
+            if !used[j] {
+                used[j] = true;
+                order.push(j);
+                rec(m, order, used, finish, best);
+                order.pop();
+                used[j] = false;
+            }
+        }
+    }
+    let mut used = vec![false; m.n];
+    used[start] = true;
+    let mut best = f64::INFINITY;
+    rec(m, &mut vec![start], &mut used, finish, &mut best);
+    best
+}
+
+/// Patch adjacency of a set of unit squares on a grid (boundary and corner connections).
+fn squares(cells: &[(i32, i32)]) -> CostMatrix {
+    let mut m = CostMatrix::new(cells.len());
+    for (i, a) in cells.iter().enumerate() {
+        for (j, b) in cells.iter().enumerate().skip(i + 1) {
+            let (dx, dy) = ((a.0 - b.0).abs(), (a.1 - b.1).abs());
+            if dx + dy == 1 {
+                m.connect(i, j, order::BOUNDARY_COST);
+            } else if dx == 1 && dy == 1 {
+                m.connect(i, j, order::CORNER_COST);
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn patch_order_equals_brute_force() {
+    let grid = |w: i32, h: i32| (0..w * h).map(|k| (k % w, k / w)).collect::<Vec<_>>();
+    let mut layouts: Vec<(String, CostMatrix)> = vec![
+        ("grid 2x2".into(), squares(&grid(2, 2))),
+        ("grid 3x3".into(), squares(&grid(3, 3))),
+        ("grid 4x2".into(), squares(&grid(4, 2))),
+        (
+            "L".into(),
+            squares(&[(0, 0), (1, 0), (2, 0), (0, 1), (0, 2), (0, 3)]),
+        ),
+        (
+            "ring".into(),
+            squares(&[
+                (0, 0),
+                (1, 0),
+                (2, 0),
+                (2, 1),
+                (2, 2),
+                (1, 2),
+                (0, 2),
+                (0, 1),
+            ]),
+        ),
+        (
+            "plus".into(),
+            squares(&[(1, 0), (0, 1), (1, 1), (2, 1), (1, 2)]),
+        ),
+        (
+            "diagonal".into(),
+            squares(&[(0, 0), (1, 1), (2, 2), (2, 1), (0, 1)]),
+        ),
+    ];
+    for name in ["keycap-convex", "keycap-concave", "head", "bumps-hole"] {
+        layouts.push((
+            name.into(),
+            patch_costs(&samples::load_sample(name).unwrap()),
+        ));
+    }
+    let v5 = tspath::io::load(valence5().as_bytes(), "v5").unwrap();
+    layouts.push(("valence 5".into(), patch_costs(&v5)));
+    for (name, m) in &layouts {
+        assert!(m.n <= 9);
+        for start in 0..m.n.min(3) {
+            for finish in [None, Some(m.n - 1)] {
+                if finish == Some(start) {
+                    continue;
+                }
+                let got = order::patch_order(m, start, finish);
+                assert_eq!(got[0], start);
+                if let Some(f) = finish {
+                    assert_eq!(*got.last().unwrap(), f);
+                }
+                let mut sorted = got.clone();
+                sorted.sort_unstable();
+                assert_eq!(
+                    sorted,
+                    (0..m.n).collect::<Vec<_>>(),
+                    "{name}: a permutation"
+                );
+                let bf = brute_force(m, start, finish);
+                assert!(
+                    (m.path_cost(&got) - bf).abs() < 1e-9,
+                    "{name} from {start} to {finish:?}: {} vs brute force {bf}",
+                    m.path_cost(&got)
+                );
+            }
+        }
+    }
+}
+
+fn valence5() -> String {
+    let mut s = String::from("v 0 0 0\n");
+    for k in 0..5 {
+        let a = k as f64 * std::f64::consts::TAU / 5.0;
+        let b = a + std::f64::consts::TAU / 10.0;
+        s += &format!(
+            "v {} {} 0\nv {} {} 0\n",
+            a.cos(),
+            a.sin(),
+            1.8 * b.cos(),
+            1.8 * b.sin()
+        );
+    }
+    for k in 0..5 {
+        s += &format!(
+            "f 1 {} {} {}\n",
+            2 + 2 * k,
+            3 + 2 * k,
+            2 + 2 * ((k + 1) % 5)
+        );
+    }
+    s
+}
+
+#[test]
+fn a_corner_connection_is_used_when_the_layout_demands_it() {
+    // The paper's fig. 5(c)(d) kind: a centre patch with three arms (left, top, right);
+    // no order visits all four through shared sides, so one move goes through a shared
+    // corner, and the transit corners must put both patches' ends on that corner.
+    let cells = [(0, 1), (1, 1), (1, 2), (2, 1)];
+    let m = squares(&cells);
+    let order = order::patch_order(&m, 0, None);
+    let corner_moves = order
+        .windows(2)
+        .filter(|w| m.get(w[0], w[1]) == order::CORNER_COST)
+        .count();
+    assert_eq!(corner_moves, 1, "{order:?}");
+    let id = |x: i32, y: i32| (y * 4 + x) as u32;
+    let ids: Vec<[u32; 4]> = cells
+        .iter()
+        .map(|&(x, y)| [id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)])
+        .collect();
+    let (transits, retractions) = corners::select(&order, &ids, &[Crossfeed::U; 4], None);
+    assert_eq!(retractions, 0);
+    for w in transits.windows(2) {
+        assert_eq!(
+            ids[w[0].patch][w[0].finish_corner as usize],
+            ids[w[1].patch][w[1].start_corner as usize]
+        );
+        assert_ne!(w[0].start_corner, w[0].finish_corner);
+    }
+    // Starting the first patch on the only corner it could leave by forces backtracking.
+    let (t2, r2) = corners::select(&order, &ids, &[Crossfeed::U; 4], None);
+    assert_eq!((t2, r2), (transits, 0));
+}
+
+/// Spacing (mm, along the surface) between the first passes of a single-patch model, and
+/// the scallop the planner used.
+fn first_spacing(m: &Model, r: f64, h: f64) -> (f64, f64) {
+    let mut opts = PlanOptions::default()
+        .with_tool_radius(r)
+        .with_scallop(h)
+        .with_chordal(0.002);
+    opts.crossfeed = Some(Crossfeed::U);
+    let path = isoparametric::plan_zigzag(m, &opts, &mut |_| true).unwrap();
+    let run = path.runs[0];
+    // The passes are lines u = const; find two adjacent ones by their params.
+    let mut us: Vec<f64> = path.params[run.first_move..=run.last_move]
+        .iter()
+        .map(|p| p[0])
+        .collect();
+    us.sort_by(f64::total_cmp);
+    us.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    let p = &m.layout.patches[0];
+    let w0 = us[0];
+    let w1 = us[1];
+    // Arc length across at v = 0.5 between the first two passes.
+    let mut len = 0.0;
+    let steps = 200;
+    let mut prev = p.subs(&m.surface, w0, 0.5);
+    for k in 1..=steps {
+        let w = w0 + (w1 - w0) * k as f64 / steps as f64;
+        let q = p.subs(&m.surface, w, 0.5);
+        len += (q - prev).norm();
+        prev = q;
+    }
+    (len, run.scallop_used_mm)
+}
+
+#[test]
+fn side_step_matches_eq5_on_plane_and_cylinders() {
+    let (r, h) = (1.0, 0.01);
+    let rr: f64 = 10.0;
+    let plane = Model::try_new("plane", "test", "mm", samples::plane_patch(20.0).unwrap()).unwrap();
+    let convex = Model::try_new(
+        "cyl",
+        "test",
+        "mm",
+        samples::cylinder_patch(rr, 20.0, 90.0, false).unwrap(),
+    )
+    .unwrap();
+    let concave = Model::try_new(
+        "trough",
+        "test",
+        "mm",
+        samples::cylinder_patch(rr, 20.0, 90.0, true).unwrap(),
+    )
+    .unwrap();
+    // Eq. 5: g = sqrt(8 h r R / (R + sign·r)), sign 0 flat, +1 convex, −1 concave.
+    for (m, sign) in [(&plane, 0.0), (&convex, 1.0), (&concave, -1.0)] {
+        let (g, h_used) = first_spacing(m, r, h);
+        // On a cylinder the planner's step is an arc across; eq. 5 gives the chord-like
+        // side step between contact points, the same to O(g³/R²).
+        let want = if sign == 0.0 {
+            (8.0 * h_used * r).sqrt()
+        } else {
+            (8.0 * h_used * r * rr / (rr + sign * r)).sqrt()
+        };
+        println!(
+            "{}: side step {g:.6} mm, eq. 5 gives {want:.6} mm at h = {h_used:.6} mm",
+            m.name
+        );
+        // The planner takes the smallest step needed on this pass, half-way and at the next
+        // (the rational patch's speed varies across), so it may be a little shorter, never
+        // longer.
+        assert!(
+            g <= want * (1.0 + 1e-6) && g >= 0.98 * want,
+            "{}: {g} vs {want}",
+            m.name
+        );
+    }
+}
+
+/// Smallest clearance (mm) of the shank above the flutes and the holder from dense surface
+/// samples, computed here without the planner's index.
+fn clearance(samples: &[Point3], c: &Point3, axis: &Vector3, o: &PlanOptions) -> f64 {
+    let (f, ls, lh) = (o.flute_length(), o.shank_length_mm, o.holder_length_mm);
+    let mut best = f64::INFINITY;
+    for p in samples {
+        let d = p - c;
+        let a = d.dot(axis);
+        let radial = (d - axis * a).norm();
+        for (a0, a1, rad) in [(f, ls, o.shank_radius()), (ls, ls + lh, o.holder_radius_mm)] {
+            // Distance from the point to the solid cylinder.
+            let out_axial = if a < a0 {
+                a0 - a
+            } else if a > a1 {
+                a - a1
+            } else {
+                0.0
+            };
+            let out_radial = (radial - rad).max(0.0);
+            let dist = if out_axial == 0.0 && out_radial == 0.0 {
+                -(rad - radial).min(a - a0).min(a1 - a)
+            } else {
+                out_axial.hypot(out_radial)
+            };
+            best = best.min(dist);
+        }
+    }
+    best
+}
+
+#[test]
+fn tool_axis_clears_shank_and_holder_and_is_vertical_where_it_can_be() {
+    let m = samples::load_sample("keycap-concave").unwrap();
+    // A fat shank close above a short flute: near the cavity walls it must lean away.
+    let mut opts = PlanOptions::default()
+        .with_tool_radius(0.5)
+        .with_scallop(0.05)
+        .with_chordal(0.005);
+    opts = opts.with_holder(1.0, 15.0, 6.0, 30.0);
+    opts.flute_length_mm = Some(1.0);
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+    let path = &planned.toolpath;
+    let t = m.tessellate(0.002);
+    let mut samples: Vec<Point3> = t
+        .positions
+        .chunks(3)
+        .map(|p| Point3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+        .collect();
+    // Densify: triangle centres and edge midpoints.
+    for tri in t.indices.chunks(3) {
+        let q: Vec<Point3> = tri.iter().map(|&i| samples[i as usize]).collect();
+        samples.push(Point3::from(
+            (q[0].coords + q[1].coords + q[2].coords) / 3.0,
+        ));
+        samples.push(Point3::from((q[0].coords + q[1].coords) / 2.0));
+    }
+    let mut tilted = 0;
+    let mut min_clear = f64::INFINITY;
+    let stride = 7;
+    for (i, mv) in path.moves.iter().enumerate() {
+        if !matches!(mv.kind, MoveKind::Feed | MoveKind::Link) || i % stride != 0 {
+            continue;
+        }
+        let c = clearance(&samples, &mv.cl_point, &mv.tool_axis, &opts);
+        min_clear = min_clear.min(c);
+        assert!(c > 0.0, "move {i}: the tool hits the model ({c} mm)");
+        if (mv.tool_axis - Vector3::z()).norm() > 1e-12 {
+            tilted += 1;
+            // Only where +Z would not have been clear (within the planner's sampling margin).
+            let cz = clearance(&samples, &mv.cl_point, &Vector3::z(), &opts);
+            assert!(cz < 0.2, "move {i}: tilted although +Z clears by {cz} mm");
+        }
+    }
+    let report = planned.report(&opts);
+    println!(
+        "keycap-concave, shank r 1 mm: {tilted} sampled points tilted, least clearance {min_clear:.4} mm, largest axis step {:.2}°",
+        report.max_axis_step_deg
+    );
+    assert!(tilted > 0, "the fat shank needs tilting near the walls");
+    assert_eq!(report.retractions, 0);
+}
