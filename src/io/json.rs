@@ -20,9 +20,9 @@
 
 use crate::error::{Error, Result};
 use crate::geom::Point3;
-use crate::tmesh::{ControlPoint, FaceLoop, Scheme, TMesh};
+use crate::tmesh::{control_point_problem, knot_problem, ControlPoint, FaceLoop, Scheme, TMesh};
 use serde_json::{json, Value};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 const FORMAT: &str = "json";
 
@@ -118,7 +118,13 @@ pub fn read(text: &str) -> Result<(TMesh, JsonMeta)> {
     };
     let default_knot = match obj.get("default_knot") {
         None => 1.0,
-        Some(v) => num(v, "\"default_knot\"")?,
+        Some(v) => {
+            let k = num(v, "\"default_knot\"")?;
+            if let Some(why) = knot_problem(k) {
+                return Err(Error::parse(FORMAT, "\"default_knot\"", why));
+            }
+            k
+        }
     };
     let pts = obj
         .get("points")
@@ -127,43 +133,58 @@ pub fn read(text: &str) -> Result<(TMesh, JsonMeta)> {
     let mut points = Vec::with_capacity(pts.len());
     for (i, p) in pts.iter().enumerate() {
         let loc = format!("points[{i}]");
-        let a = p
-            .as_array()
-            .filter(|a| a.len() == 3 || a.len() == 4)
-            .ok_or_else(|| Error::parse(FORMAT, &loc, "expected [x, y, z] or [x, y, z, w]"))?;
+        let a = p.as_array().ok_or_else(|| {
+            Error::parse(
+                FORMAT,
+                &loc,
+                format!("expected [x, y, z] or [x, y, z, w], found {p}"),
+            )
+        })?;
+        if a.len() != 3 && a.len() != 4 {
+            return Err(Error::parse(
+                FORMAT,
+                &loc,
+                format!(
+                    "expected [x, y, z] or [x, y, z, w], found {} numbers",
+                    a.len()
+                ),
+            ));
+        }
         let c: Vec<f64> = a.iter().map(|x| num(x, &loc)).collect::<Result<_>>()?;
-        points.push(ControlPoint {
+        let point = ControlPoint {
             point: Point3::new(c[0] * scale, c[1] * scale, c[2] * scale),
             weight: c.get(3).copied().unwrap_or(1.0),
-        });
+        };
+        if let Some(why) = control_point_problem(&point) {
+            return Err(Error::parse(FORMAT, &loc, why));
+        }
+        points.push(point);
     }
+    let np = points.len();
     let fcs = obj
         .get("faces")
         .and_then(Value::as_array)
         .ok_or_else(|| Error::parse(FORMAT, "\"faces\"", "missing or not an array"))?;
     let mut faces = Vec::with_capacity(fcs.len());
+    // Undirected edges of the faces, for checking the knot records.
+    let mut edges = HashSet::new();
     for (i, f) in fcs.iter().enumerate() {
         let loc = format!("faces[{i}]");
         let (verts, corners) = match f {
             Value::Array(a) => (a, None),
             Value::Object(o) => (
-                o.get("vertices")
-                    .and_then(Value::as_array)
-                    .ok_or_else(|| Error::parse(FORMAT, &loc, "object face needs \"vertices\""))?,
-                Some(
-                    o.get("corners")
-                        .and_then(Value::as_array)
-                        .filter(|c| c.len() == 4)
-                        .ok_or_else(|| {
-                            Error::parse(FORMAT, &loc, "object face needs four \"corners\"")
-                        })?,
-                ),
+                o.get("vertices").and_then(Value::as_array).ok_or_else(|| {
+                    Error::parse(FORMAT, &loc, "object face needs a \"vertices\" list")
+                })?,
+                Some(o.get("corners").and_then(Value::as_array).ok_or_else(|| {
+                    Error::parse(FORMAT, &loc, "object face needs a \"corners\" list")
+                })?),
             ),
             _ => {
                 return Err(Error::parse(
                     FORMAT,
                     &loc,
-                    "expected a vertex list or an object",
+                    format!("expected a vertex list or an object, found {f}"),
                 ))
             }
         };
@@ -171,38 +192,118 @@ pub fn read(text: &str) -> Result<(TMesh, JsonMeta)> {
             .iter()
             .map(|x| index(x, &loc))
             .collect::<Result<_>>()?;
+        if let Some(&v) = vertices.iter().find(|&&v| v as usize >= np) {
+            return Err(Error::parse(
+                FORMAT,
+                &loc,
+                format!(
+                    "vertex {v} does not exist: there are {np} points (indices 0 to {})",
+                    np as i64 - 1
+                ),
+            ));
+        }
+        let n = vertices.len();
         let corners = match corners {
-            None if vertices.len() == 4 => [0, 1, 2, 3],
+            None if n == 4 => [0, 1, 2, 3],
             None => {
                 return Err(Error::parse(
                     FORMAT,
                     &loc,
                     format!(
-                        "{} vertices: a face with T-junctions must list its four corners",
-                        vertices.len()
+                        "a plain vertex list is a quadrilateral and needs 4 vertices, found {n} \
+                         vertices (a face with T-junctions is an object with \"vertices\" and \
+                         \"corners\")"
                     ),
                 ))
             }
             Some(c) => {
-                let c: Vec<u32> = c.iter().map(|x| index(x, &loc)).collect::<Result<_>>()?;
+                if n < 3 {
+                    return Err(Error::parse(
+                        FORMAT,
+                        &loc,
+                        format!("a face needs at least 3 vertices, found {n} vertices"),
+                    ));
+                }
+                if c.len() != 4 {
+                    return Err(Error::parse(
+                        FORMAT,
+                        &loc,
+                        format!(
+                            "expected four \"corners\" (loop positions of the face's corners), found {}",
+                            c.len()
+                        ),
+                    ));
+                }
+                let c: Vec<u32> = c
+                    .iter()
+                    .map(|x| {
+                        x.as_u64()
+                            .filter(|&k| (k as usize) < n)
+                            .map(|k| k as u32)
+                            .ok_or_else(|| {
+                                Error::parse(
+                                    FORMAT,
+                                    &loc,
+                                    format!(
+                                        "corner {x} is not a loop position of its {n} vertices (0 to {})",
+                                        n - 1
+                                    ),
+                                )
+                            })
+                    })
+                    .collect::<Result<_>>()?;
                 [c[0], c[1], c[2], c[3]]
             }
         };
+        for k in 0..n {
+            let (a, b) = (vertices[k], vertices[(k + 1) % n]);
+            edges.insert((a.min(b), a.max(b)));
+        }
         faces.push(FaceLoop { vertices, corners });
     }
-    let mut knots = HashMap::new();
+    // Interval of each edge and the record that gave it.
+    let mut knots: HashMap<(u32, u32), f64> = HashMap::new();
+    let mut knot_record: HashMap<(u32, u32), usize> = HashMap::new();
     if let Some(k) = obj.get("knots") {
         let arr = k.as_array().ok_or_else(|| {
             Error::parse(FORMAT, "\"knots\"", "expected an array of [a, b, interval]")
         })?;
         for (i, e) in arr.iter().enumerate() {
             let loc = format!("knots[{i}]");
-            let a = e
-                .as_array()
-                .filter(|a| a.len() == 3)
-                .ok_or_else(|| Error::parse(FORMAT, &loc, "expected [a, b, interval]"))?;
+            let a = e.as_array().filter(|a| a.len() == 3).ok_or_else(|| {
+                Error::parse(
+                    FORMAT,
+                    &loc,
+                    format!("expected [a, b, interval], found {e}"),
+                )
+            })?;
             let (x, y) = (index(&a[0], &loc)?, index(&a[1], &loc)?);
-            knots.insert((x.min(y), x.max(y)), num(&a[2], &loc)?);
+            let key = (x.min(y), x.max(y));
+            if !edges.contains(&key) {
+                return Err(Error::parse(
+                    FORMAT,
+                    &loc,
+                    format!("no face has an edge between vertices {x} and {y}"),
+                ));
+            }
+            let interval = num(&a[2], &loc)?;
+            if let Some(why) = knot_problem(interval) {
+                return Err(Error::parse(FORMAT, &loc, why));
+            }
+            if let Some(&j) = knot_record.get(&key) {
+                if knots[&key] != interval {
+                    return Err(Error::parse(
+                        FORMAT,
+                        &loc,
+                        format!(
+                            "edge {x}-{y} already has interval {} from knots[{j}]",
+                            knots[&key]
+                        ),
+                    ));
+                }
+            }
+            knots.insert(key, interval);
+            knot_record.entry(key).or_insert(i);
         }
     }
     let mesh = TMesh::try_new(points, &faces, &knots, default_knot, scheme)?;

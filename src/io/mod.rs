@@ -37,7 +37,13 @@ pub fn detect(bytes: &[u8]) -> Result<Format> {
     let start = bytes
         .iter()
         .position(|b| !b.is_ascii_whitespace())
-        .ok_or_else(|| Error::parse("model", "byte 0", "the file is empty"))?;
+        .ok_or_else(|| {
+            Error::parse(
+                "model",
+                "byte 0",
+                "the file is empty or holds only whitespace",
+            )
+        })?;
     let head = &bytes[start..];
     if head.starts_with(b"{") {
         Ok(Format::Json)

@@ -9,14 +9,21 @@
 
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector4};
-use crate::tmesh::{ControlPoint, FaceLoop, Scheme, TMesh};
-use std::collections::HashMap;
+use crate::tmesh::{control_point_problem, ControlPoint, FaceLoop, Scheme, TMesh};
+use std::collections::{HashMap, HashSet};
 
 const FORMAT: &str = "obj";
 
 /// Reads an OBJ cage. Coordinates are taken as millimetres.
+///
+/// Errors name the line at fault, with vertices numbered as in the file (from 1): bad
+/// records, and the topology a surface cannot have (an edge shared by more than two faces,
+/// neighbouring faces oriented inconsistently, faces meeting only at a vertex).
 pub fn read(text: &str) -> Result<TMesh> {
     let mut pts: Vec<Vector4> = Vec::new();
+    // Line (1-based) of each vertex and face record.
+    let mut vertex_line: Vec<usize> = Vec::new();
+    let mut face_line: Vec<usize> = Vec::new();
     let mut faces: Vec<Vec<u32>> = Vec::new();
     for (ln, raw) in text.lines().enumerate() {
         let line = raw.split('#').next().unwrap_or("").trim();
@@ -41,15 +48,15 @@ pub fn read(text: &str) -> Result<TMesh> {
                         format!("a vertex needs x y z [w], found {} numbers", nums.len()),
                     ));
                 }
-                let w = nums.get(3).copied().unwrap_or(1.0);
-                if !(w > 0.0) {
-                    return Err(Error::parse(
-                        FORMAT,
-                        loc(),
-                        format!("vertex weight {w} must be positive"),
-                    ));
+                let cp = ControlPoint {
+                    point: Point3::new(nums[0], nums[1], nums[2]),
+                    weight: nums.get(3).copied().unwrap_or(1.0),
+                };
+                if let Some(why) = control_point_problem(&cp) {
+                    return Err(Error::parse(FORMAT, loc(), why));
                 }
-                pts.push(Vector4::new(nums[0] * w, nums[1] * w, nums[2] * w, w));
+                pts.push(cp.homogeneous());
+                vertex_line.push(ln + 1);
             }
             Some("f") => {
                 let mut face = Vec::new();
@@ -59,8 +66,15 @@ pub fn read(text: &str) -> Result<TMesh> {
                         Error::parse(FORMAT, loc(), format!("`{w}` is not a vertex index"))
                     })?;
                     let n = pts.len() as i64;
+                    if i == 0 {
+                        return Err(Error::parse(
+                            FORMAT,
+                            loc(),
+                            "vertex index 0: OBJ vertex indices start at 1 (negative ones count back from the last vertex)",
+                        ));
+                    }
                     let idx = if i > 0 { i - 1 } else { n + i };
-                    if i == 0 || idx < 0 || idx >= n {
+                    if idx < 0 || idx >= n {
                         return Err(Error::parse(
                             FORMAT,
                             loc(),
@@ -77,6 +91,7 @@ pub fn read(text: &str) -> Result<TMesh> {
                     ));
                 }
                 faces.push(face);
+                face_line.push(ln + 1);
             }
             _ => {}
         }
@@ -88,6 +103,7 @@ pub fn read(text: &str) -> Result<TMesh> {
             "no faces (`f` records) found",
         ));
     }
+    check_topology(&faces, &face_line, &vertex_line)?;
     // Drop unused vertices.
     let mut map: HashMap<u32, u32> = HashMap::new();
     let mut used = Vec::new();
@@ -116,6 +132,124 @@ pub fn read(text: &str) -> Result<TMesh> {
         .map(|f| FaceLoop::quad(f[0], f[1], f[2], f[3]))
         .collect();
     TMesh::try_new(points, &loops, &HashMap::new(), 1.0, Scheme::CatmullClark)
+}
+
+/// "lines 3 and 7", "lines 3, 7 and 9".
+fn lines_list(lines: &[usize]) -> String {
+    let mut s: Vec<String> = lines.iter().map(usize::to_string).collect();
+    let last = s.pop().unwrap_or_default();
+    if s.is_empty() {
+        format!("line {last}")
+    } else {
+        format!("lines {} and {last}", s.join(", "))
+    }
+}
+
+fn find_root(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
+/// Checks that the faces (0-based vertex indices) form a manifold surface that can be
+/// oriented as given, naming the file's lines and 1-based vertex numbers at fault.
+fn check_topology(faces: &[Vec<u32>], face_line: &[usize], vertex_line: &[usize]) -> Result<()> {
+    // A face is a simple loop.
+    for (f, face) in faces.iter().enumerate() {
+        let mut seen = HashSet::new();
+        if let Some(&v) = face.iter().find(|&&v| !seen.insert(v)) {
+            return Err(Error::InvalidMesh(format!(
+                "line {}: the face uses vertex {} twice; a face must be a simple loop of distinct vertices",
+                face_line[f],
+                v + 1
+            )));
+        }
+    }
+    // Faces of each undirected edge, with the direction each runs along it, in file order.
+    let mut edge_faces: HashMap<(u32, u32), Vec<(usize, bool)>> = HashMap::new();
+    let mut edge_order: Vec<(u32, u32)> = Vec::new();
+    for (f, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            let (a, b) = (face[k], face[(k + 1) % face.len()]);
+            let e = edge_faces.entry((a.min(b), a.max(b))).or_default();
+            if e.is_empty() {
+                edge_order.push((a.min(b), a.max(b)));
+            }
+            e.push((f, a < b));
+        }
+    }
+    for key in &edge_order {
+        let fs = &edge_faces[key];
+        if fs.len() > 2 {
+            let lines: Vec<usize> = fs.iter().map(|&(f, _)| face_line[f]).collect();
+            return Err(Error::InvalidMesh(format!(
+                "edge {}–{} is shared by the faces on {}: an edge of a surface borders at most two faces (non-manifold edge)",
+                key.0 + 1,
+                key.1 + 1,
+                lines_list(&lines)
+            )));
+        }
+    }
+    for key in &edge_order {
+        if let [(f, d), (g, e)] = edge_faces[key][..] {
+            if d == e {
+                let (a, b) = if d { *key } else { (key.1, key.0) };
+                return Err(Error::InvalidMesh(format!(
+                    "the faces on {} both run from vertex {} to vertex {}: neighbouring faces must be oriented consistently, running along a shared edge in opposite directions (reverse the vertex order of one of them)",
+                    lines_list(&[face_line[f], face_line[g]]),
+                    a + 1,
+                    b + 1
+                )));
+            }
+        }
+    }
+    // Around each vertex its faces must form one fan: faces at the vertex joined through
+    // the edges at the vertex they share. Corners are (face, position) pairs.
+    let mut first_corner = Vec::with_capacity(faces.len());
+    let mut total = 0;
+    for face in faces {
+        first_corner.push(total);
+        total += face.len();
+    }
+    let corner_of = |f: usize, v: u32| -> usize {
+        first_corner[f] + faces[f].iter().position(|&w| w == v).unwrap_or(0)
+    };
+    let mut parent: Vec<usize> = (0..total).collect();
+    for key in &edge_order {
+        if let [(f, _), (g, _)] = edge_faces[key][..] {
+            for v in [key.0, key.1] {
+                let (a, b) = (
+                    find_root(&mut parent, corner_of(f, v)),
+                    find_root(&mut parent, corner_of(g, v)),
+                );
+                parent[a] = b;
+            }
+        }
+    }
+    // For each vertex, the first face of its first fan and the first face of another fan.
+    let mut fan: HashMap<u32, (usize, usize)> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for &v in face {
+            let root = find_root(&mut parent, corner_of(f, v));
+            match fan.get(&v) {
+                None => {
+                    fan.insert(v, (root, f));
+                }
+                Some(&(r, g)) if r != root => {
+                    return Err(Error::InvalidMesh(format!(
+                        "vertex {} (line {}) joins faces that share no edge there, such as the faces on {}: a non-manifold (bow-tie) vertex; give each fan of faces its own vertex",
+                        v + 1,
+                        vertex_line[v as usize],
+                        lines_list(&[face_line[g], face_line[f]])
+                    )));
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    Ok(())
 }
 
 /// One Catmull–Clark step on a polygon mesh (homogeneous points), with sharp boundaries and

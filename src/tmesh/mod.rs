@@ -117,6 +117,57 @@ pub struct TMesh {
 /// Relative tolerance (of the larger side) for comparing sums of knot intervals.
 pub(crate) const KNOT_MATCH_REL: f64 = 1e-9;
 
+/// Largest control-point coordinate accepted, in mm (1000 km: no machine is bigger). Keeps
+/// the products and sums of rational evaluation far from `f64` overflow.
+pub const MAX_COORDINATE_MM: f64 = 1e9;
+
+/// Accepted control-point weights `[min, max]`. Only ratios of weights shape the surface;
+/// weights this far apart already mean a degenerate model, and farther apart rational
+/// evaluation over- or underflows.
+pub const WEIGHT_RANGE: [f64; 2] = [1e-6, 1e6];
+
+/// Accepted positive knot intervals `[min, max]` (parameter units; 0 is also accepted and
+/// means a repeated knot). Beyond them basis evaluation divides by near-zero spans or sums
+/// overflow.
+pub const KNOT_RANGE: [f64; 2] = [1e-9, 1e9];
+
+/// Why a knot interval is not accepted (`None` if it is: 0, or within [`KNOT_RANGE`]).
+pub fn knot_problem(knot: f64) -> Option<String> {
+    if knot == 0.0 || (KNOT_RANGE[0]..=KNOT_RANGE[1]).contains(&knot) {
+        None
+    } else {
+        Some(format!(
+            "knot interval {knot} is not 0 or between {:e} and {:e}",
+            KNOT_RANGE[0], KNOT_RANGE[1]
+        ))
+    }
+}
+
+/// Why a control point is not accepted (`None` if it is): coordinates within
+/// ±[`MAX_COORDINATE_MM`], weight within [`WEIGHT_RANGE`].
+pub fn control_point_problem(p: &ControlPoint) -> Option<String> {
+    if let Some(c) = [p.point.x, p.point.y, p.point.z]
+        .into_iter()
+        .find(|c| !(c.abs() <= MAX_COORDINATE_MM))
+    {
+        return Some(format!(
+            "coordinate {c} mm is not a number within ±{MAX_COORDINATE_MM:e} mm"
+        ));
+    }
+    if !(WEIGHT_RANGE[0]..=WEIGHT_RANGE[1]).contains(&p.weight) {
+        let why = if p.weight > 0.0 {
+            ""
+        } else {
+            " (weights must be positive)"
+        };
+        return Some(format!(
+            "weight {} is not between {:e} and {:e}{why}",
+            p.weight, WEIGHT_RANGE[0], WEIGHT_RANGE[1]
+        ));
+    }
+    None
+}
+
 impl TMesh {
     /// Builds and validates a T-mesh.
     ///
@@ -131,25 +182,15 @@ impl TMesh {
     ) -> Result<Self> {
         let nv = points.len();
         for (i, p) in points.iter().enumerate() {
-            if !(p.point.x.is_finite() && p.point.y.is_finite() && p.point.z.is_finite()) {
-                return Err(Error::InvalidMesh(format!(
-                    "control point {i} has a non-finite coordinate"
-                )));
-            }
-            if !(p.weight.is_finite() && p.weight > 0.0) {
-                return Err(Error::InvalidMesh(format!(
-                    "control point {i} has weight {}; weights must be positive",
-                    p.weight
-                )));
+            if let Some(why) = control_point_problem(p) {
+                return Err(Error::InvalidMesh(format!("control point {i}: {why}")));
             }
         }
         if faces.is_empty() {
             return Err(Error::InvalidMesh("the mesh has no faces".into()));
         }
-        if !(default_knot.is_finite() && default_knot >= 0.0) {
-            return Err(Error::InvalidMesh(format!(
-                "default knot interval {default_knot} is not ≥ 0"
-            )));
+        if let Some(why) = knot_problem(default_knot) {
+            return Err(Error::InvalidMesh(format!("default {why}")));
         }
         let mut half_edges: Vec<HalfEdge> = Vec::new();
         let mut out_faces = Vec::with_capacity(faces.len());
@@ -159,7 +200,7 @@ impl TMesh {
             let n = fl.vertices.len();
             if n < 3 {
                 return Err(Error::InvalidMesh(format!(
-                    "face {fi} has {n} vertices; at least 4 needed"
+                    "face {fi} has {n} vertices; at least 3 needed (4 corners, two of which may share a position on a zero-area face)"
                 )));
             }
             let c = fl.corners;
@@ -211,15 +252,14 @@ impl TMesh {
                 used[a as usize] = true;
                 let key = (a.min(b), a.max(b));
                 let knot = knots.get(&key).copied().unwrap_or(default_knot);
-                if !(knot.is_finite() && knot >= 0.0) {
-                    return Err(Error::InvalidMesh(format!(
-                        "edge {a}-{b} has knot interval {knot}; must be ≥ 0"
-                    )));
+                if let Some(why) = knot_problem(knot) {
+                    return Err(Error::InvalidMesh(format!("edge {a}-{b}: {why}")));
                 }
                 let id = base + k as u32;
-                if directed.insert((a, b), id).is_some() {
+                if let Some(other) = directed.insert((a, b), id) {
                     return Err(Error::InvalidMesh(format!(
-                        "edge {a}->{b} is used twice in the same direction (face {fi}): non-manifold or inconsistently oriented faces"
+                        "edge {a}->{b} is used in the same direction by faces {} and {fi}: an edge borders at most two faces, which run along it in opposite directions (check the faces' orientation)",
+                        half_edges[other as usize].face
                     )));
                 }
                 half_edges.push(HalfEdge {
