@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use crate::machine::{self, JobInfo};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions};
+use crate::verify::{self, CutterPath, VerifyOptions};
 use std::time::Instant;
 
 const USAGE: &str = "usage:
@@ -12,8 +13,12 @@ const USAGE: &str = "usage:
   tspath sample --list
   tspath sample NAME -o FILE.json
   tspath plan MODEL [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
-              [-o OUT.nc] [--report REPORT.json]
+              [-o OUT.nc] [--report REPORT.json] [--verify [--verify-samples N]]
+  tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--scallop MM]
+              [--gouge-tolerance MM]
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
+verify simulates the ball-end cut of a G-code program (as `plan` writes it) or of a
+tspath-cl JSON tool path and prints the scallops and gouges it leaves as JSON.
 ";
 
 /// Runs one command; returns what it prints on success.
@@ -26,6 +31,7 @@ pub fn run(args: &[String]) -> Result<String> {
         "info" => info(rest),
         "sample" => sample(rest),
         "plan" => plan(rest),
+        "verify" => verify_cmd(rest),
         "-h" | "--help" | "help" => Ok(USAGE.into()),
         other => Err(Error::Io(format!("unknown command `{other}`\n{USAGE}"))),
     }
@@ -92,6 +98,15 @@ impl Args<'_> {
     fn has(&self, flag: &str) -> bool {
         self.flags.iter().any(|(f, _)| *f == flag)
     }
+    fn count(&self, flag: &'static str) -> Result<Option<usize>> {
+        match self.value(flag) {
+            None => Ok(None),
+            Some(v) => v
+                .parse::<usize>()
+                .map(Some)
+                .map_err(|_| Error::Io(format!("{flag}: `{v}` is not a whole number"))),
+        }
+    }
     fn number(&self, flag: &'static str) -> Result<Option<f64>> {
         match self.value(flag) {
             None => Ok(None),
@@ -149,8 +164,9 @@ fn plan(args: &[String]) -> Result<String> {
             "--feed",
             "-o",
             "--report",
+            "--verify-samples",
         ],
-        &[],
+        &["--verify"],
     )?;
     let [model] = a.positional[..] else {
         return Err(Error::Io(format!("plan takes one MODEL\n{USAGE}")));
@@ -181,7 +197,19 @@ fn plan(args: &[String]) -> Result<String> {
             strategy: "isoparametric".into(),
         },
     );
-    let report_json = serde_json::to_string_pretty(&report).expect("report serialises") + "\n";
+    let mut report_value = serde_json::to_value(&report).expect("report serialises");
+    if a.has("--verify") {
+        let mut vopts = VerifyOptions::default()
+            .with_scallop(opts.scallop_mm)
+            .with_gouge_tolerance(opts.chordal_mm);
+        if let Some(n) = a.count("--verify-samples")? {
+            vopts = vopts.with_samples(n);
+        }
+        let v = verify::verify(&m.surface, &CutterPath::from_toolpath(&path)?, &vopts)?;
+        report_value["verify"] = serde_json::to_value(&v).expect("verification serialises");
+    }
+    let report_json =
+        serde_json::to_string_pretty(&report_value).expect("report serialises") + "\n";
     let mut out = String::new();
     match a.value("-o") {
         Some(p) => write_file(p, &gcode)?,
@@ -193,4 +221,63 @@ fn plan(args: &[String]) -> Result<String> {
         None => {}
     }
     Ok(out)
+}
+
+fn verify_cmd(args: &[String]) -> Result<String> {
+    let a = parse(
+        args,
+        &[
+            "--tool-radius",
+            "--samples",
+            "--scallop",
+            "--gouge-tolerance",
+        ],
+        &[],
+    )?;
+    let [model, path_file] = a.positional[..] else {
+        return Err(Error::Io(format!(
+            "verify takes a MODEL and a G-code or tool path file\n{USAGE}"
+        )));
+    };
+    let Some(r) = a.number("--tool-radius")? else {
+        return Err(Error::Io(format!(
+            "verify needs --tool-radius MM (the ball-end radius)\n{USAGE}"
+        )));
+    };
+    let m = load_model(model)?;
+    let text = std::fs::read_to_string(path_file)
+        .map_err(|e| Error::Io(format!("cannot read {path_file}: {e}")))?;
+    let mut opts = VerifyOptions::default();
+    let path = if text.trim_start().starts_with('{') {
+        CutterPath::from_cl_json(&text, r)?
+    } else {
+        let prog = verify::gcode::read_3axis(&text)?;
+        if let Some(hr) = prog.header_tool_radius_mm {
+            if hr != r {
+                return Err(Error::param(
+                    "tool_radius_mm",
+                    format!("{path_file} says it was made for a ball-end radius {hr} mm, but --tool-radius is {r} mm"),
+                ));
+            }
+        }
+        // The tolerances the program was made for, unless given.
+        if let Some(h) = prog.header_scallop_mm {
+            opts.scallop_mm = h;
+        }
+        if let Some(c) = prog.header_chordal_mm {
+            opts.gouge_tolerance_mm = c;
+        }
+        CutterPath::from_tool_tips(r, prog.tips)?
+    };
+    if let Some(h) = a.number("--scallop")? {
+        opts.scallop_mm = h;
+    }
+    if let Some(t) = a.number("--gouge-tolerance")? {
+        opts.gouge_tolerance_mm = t;
+    }
+    if let Some(n) = a.count("--samples")? {
+        opts.samples = n;
+    }
+    let v = verify::verify(&m.surface, &path, &opts)?;
+    Ok(serde_json::to_string_pretty(&v).expect("verification serialises") + "\n")
 }

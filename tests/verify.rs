@@ -443,3 +443,68 @@ fn planned_paths_keep_their_scallop_and_do_not_gouge() {
         assert!(v.max_gouge_mm <= opts.chordal_mm + v.gouge_error_bound_mm);
     }
 }
+
+#[test]
+fn heat_map_follows_the_tessellation() {
+    use tspath::surface::tessellate::tessellate;
+    let (big_r, len, r) = (5.0, 4.0, 0.5);
+    let s = quarter_cylinder(big_r, len);
+    let mesh = tessellate(&s, 0.001);
+    let nverts = mesh.positions.len() / 3;
+    assert!(nverts > 100, "{nverts} vertices");
+    // Passes over the half of the arc with x < 0 only, one of them dipping by 0.02 mm.
+    let passes = 40;
+    let theta = std::f64::consts::FRAC_PI_2 / passes as f64;
+    let mut pts: Vec<Point3> = cylinder_passes(big_r + r, theta, len)
+        .into_iter()
+        .filter(|p| p.x < 0.0)
+        .collect();
+    let k = 4 * 2; // a pass start; dip half-way along it
+    let (a, b) = (pts[k], pts[k + 1]);
+    let mid = Point3::from((a.coords + b.coords) * 0.5);
+    let dip = 0.02;
+    let inward = Vector3::new(mid.x, 0.0, mid.z).normalize();
+    pts.insert(k + 1, mid - inward * dip);
+    let opts = VerifyOptions::default().with_samples(200_000);
+    let (v, heat) = verify::verify_with_heat_map(&s, &path(r, &pts), &opts, &mesh).unwrap();
+    assert_eq!(heat.len(), nverts);
+    let cusp = {
+        let d = big_r + r;
+        let half = 0.5 * theta;
+        d * half.cos() - (r * r - (d * half.sin()).powi(2)).sqrt() - big_r
+    };
+    let mut finite_max = f32::NEG_INFINITY;
+    for (i, &h) in heat.iter().enumerate() {
+        let x = mesh.positions[3 * i] as f64;
+        let z = mesh.positions[3 * i + 2] as f64;
+        // The dipped pass descends all along its length: keep clear of it sideways.
+        let from_dip = big_r * (x.atan2(z) - mid.x.atan2(mid.z)).abs();
+        assert!(!h.is_nan(), "vertex {i} has no value");
+        if x > 1.0 {
+            // More than a tool radius beyond the last pass: never reached.
+            assert!(h == f32::INFINITY, "vertex {i} at x = {x}: {h}");
+        } else if x < -0.2 && from_dip > 1.0 {
+            assert!(h.is_finite() && h >= 0.0, "vertex {i} at x = {x}: {h}");
+            finite_max = finite_max.max(h);
+        }
+    }
+    assert!(finite_max as f64 <= cusp + 1e-6 && finite_max as f64 > cusp - 2e-3);
+    // The vertex nearest the bottom of the dip shows the gouge.
+    let bottom = mid - inward * (dip + r);
+    let nearest = (0..nverts)
+        .min_by(|&i, &j| {
+            let d = |k: usize| {
+                (Point3::new(
+                    mesh.positions[3 * k] as f64,
+                    mesh.positions[3 * k + 1] as f64,
+                    mesh.positions[3 * k + 2] as f64,
+                ) - bottom)
+                    .norm()
+            };
+            d(i).total_cmp(&d(j))
+        })
+        .unwrap();
+    assert!(heat[nearest] < 0.0, "{}", heat[nearest]);
+    assert!(-(heat[nearest] as f64) <= v.max_gouge_mm + 1e-6);
+    assert!(v.unreached_fraction > 0.3 && v.unreached_fraction < 0.6);
+}

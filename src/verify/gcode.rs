@@ -22,6 +22,8 @@ pub struct GcodeProgram {
     pub header_tool_radius_mm: Option<f64>,
     /// Scallop height from the same header comment, if present.
     pub header_scallop_mm: Option<f64>,
+    /// Chordal tolerance from the same header comment, if present.
+    pub header_chordal_mm: Option<f64>,
 }
 
 /// Millimetres per inch.
@@ -50,6 +52,7 @@ pub fn read_3axis(text: &str) -> Result<GcodeProgram> {
         tips: Vec::new(),
         header_tool_radius_mm: None,
         header_scallop_mm: None,
+        header_chordal_mm: None,
     };
     let mut pos: [Option<f64>; 3] = [None; 3];
     let mut motion: Option<u32> = None;
@@ -76,6 +79,7 @@ pub fn read_3axis(text: &str) -> Result<GcodeProgram> {
             if comment.trim_start().starts_with("tool:") {
                 prog.header_tool_radius_mm = number_after(comment, "radius");
                 prog.header_scallop_mm = number_after(comment, "scallop");
+                prog.header_chordal_mm = number_after(comment, "chordal");
             }
             rest = &rest[open + close + 1..];
         }
@@ -222,6 +226,7 @@ mod tests {
         let p = read_3axis(text).unwrap();
         assert_eq!(p.header_tool_radius_mm, Some(0.5));
         assert_eq!(p.header_scallop_mm, Some(0.01));
+        assert_eq!(p.header_chordal_mm, Some(0.005));
         let tips: Vec<[f64; 3]> = p.tips.iter().map(|t| [t.tip.x, t.tip.y, t.tip.z]).collect();
         assert_eq!(
             tips,
