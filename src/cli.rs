@@ -14,11 +14,12 @@ const USAGE: &str = "usage:
   tspath sample NAME -o FILE.json
   tspath plan MODEL [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [-o OUT.nc] [--report REPORT.json] [--verify [--verify-samples N]]
-  tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--scallop MM]
-              [--gouge-tolerance MM]
+  tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
+              [--scallop MM] [--gouge-tolerance MM]
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
 verify simulates the ball-end cut of a G-code program (as `plan` writes it) or of a
-tspath-cl JSON tool path and prints the scallops and gouges it leaves as JSON.
+tspath-cl JSON tool path and prints the scallops and gouges it leaves as JSON; --bound
+raises the sample count until the stated error bound is within MM.
 ";
 
 /// Runs one command; returns what it prints on success.
@@ -229,6 +230,7 @@ fn verify_cmd(args: &[String]) -> Result<String> {
         &[
             "--tool-radius",
             "--samples",
+            "--bound",
             "--scallop",
             "--gouge-tolerance",
         ],
@@ -278,6 +280,9 @@ fn verify_cmd(args: &[String]) -> Result<String> {
     if let Some(n) = a.count("--samples")? {
         opts.samples = n;
     }
-    let v = verify::verify(&m.surface, &path, &opts)?;
+    let v = match a.number("--bound")? {
+        Some(b) => verify::verify_to_bound(&m.surface, &path, &opts, b)?,
+        None => verify::verify(&m.surface, &path, &opts)?,
+    };
     Ok(serde_json::to_string_pretty(&v).expect("verification serialises") + "\n")
 }

@@ -508,3 +508,28 @@ fn heat_map_follows_the_tessellation() {
     assert!(-(heat[nearest] as f64) <= v.max_gouge_mm + 1e-6);
     assert!(v.unreached_fraction > 0.3 && v.unreached_fraction < 0.6);
 }
+
+#[test]
+fn results_do_not_depend_on_threads() {
+    let m = samples::load_sample("dome").unwrap();
+    let opts = PlanOptions::default()
+        .with_tool_radius(2.0)
+        .with_scallop(0.05);
+    let p = isoparametric::plan_zigzag(&m, &opts, &mut |_| true).unwrap();
+    let cp = CutterPath::from_toolpath(&p).unwrap();
+    let mesh = tspath::surface::tessellate::tessellate(&m.surface, 0.01);
+    let run = |threads| {
+        let o = VerifyOptions::default()
+            .with_samples(100_000)
+            .with_threads(threads);
+        let (v, heat) = verify::verify_with_heat_map(&m.surface, &cp, &o, &mesh).unwrap();
+        (serde_json::to_string(&v).unwrap(), heat)
+    };
+    let (a, ha) = run(1);
+    let (b, hb) = run(3);
+    assert_eq!(a, b);
+    assert_eq!(
+        ha.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+        hb.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+    );
+}

@@ -96,6 +96,23 @@ fn gcode_from_plan_verifies_like_the_planned_path() {
     }
     assert!(num(&v, "max_scallop_mm") > 0.015 && num(&v, "max_scallop_mm") < 0.025);
     assert_eq!(v["unreached_samples"], 0);
+
+    // --bound raises the sample count until the stated bound is reached.
+    let out = run(&args(&[
+        "verify",
+        "dome",
+        nc.to_str().unwrap(),
+        "--tool-radius",
+        "1",
+        "--samples",
+        "20000",
+        "--bound",
+        "0.004",
+    ]))
+    .unwrap();
+    let b: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(num(&b, "error_bound_mm") <= 0.004, "{}", b["error_bound_mm"]);
+    assert!(num(&b, "samples") > 20000.0);
 }
 
 #[test]

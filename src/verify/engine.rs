@@ -69,7 +69,8 @@ struct Acc {
     refined: usize,
     gouge_slack: f64,
     spacing: f64,
-    values: Vec<(f64, f64)>,
+    /// (scallop, area weight) of every reached sample, one chunk per band.
+    values: Vec<Vec<(f64, f64)>>,
 }
 
 impl Acc {
@@ -276,6 +277,7 @@ fn band(
     let h_req = ctx.opts.scallop_mm;
     let mut acc = Acc::default();
     let mut deepest: Option<(f64, f64, f64)> = None;
+    let mut values: Vec<(f64, f64)> = Vec::new();
     let mut prev: Vec<Sample> = Vec::new();
     let mut row: Vec<Sample> = Vec::with_capacity(nu);
     for j in j0..=j1 {
@@ -320,7 +322,7 @@ fn band(
                 }
                 let scallop = left.max(0.0);
                 acc.scallop_area += scallop * w;
-                acc.values.push((scallop, w));
+                values.push((scallop, w));
             }
         }
         if j > j0 {
@@ -361,6 +363,7 @@ fn band(
         }
         std::mem::swap(&mut prev, &mut row);
     }
+    acc.values.push(values);
     if let Some((_, u, v)) = deepest {
         let bottom = gouge_bottom(ctx, probe, face, u, v, du, dv);
         acc.max_gouge = acc.max_gouge.max(-bottom);
@@ -458,14 +461,19 @@ fn work_items(grids: &[FaceGrid]) -> Vec<(usize, usize, usize, bool)> {
     items
 }
 
-fn threads() -> usize {
+fn threads(asked: usize) -> usize {
     #[cfg(target_arch = "wasm32")]
     {
+        let _ = asked;
         1
     }
     #[cfg(not(target_arch = "wasm32"))]
     {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
+        if asked > 0 {
+            asked
+        } else {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        }
     }
 }
 
@@ -475,7 +483,7 @@ fn run_items(
     items: &[(usize, usize, usize, bool)],
     heat: Option<&mut HeatMap>,
 ) -> Vec<Acc> {
-    let workers = threads().min(items.len()).max(1);
+    let workers = threads(ctx.opts.threads).min(items.len()).max(1);
     let new_probe = || {
         Probe::new(
             ctx.capsules,

@@ -67,6 +67,9 @@ pub struct VerifyOptions {
     pub gouge_tolerance_mm: f64,
     /// Side the tool works from. Default: decided from the path.
     pub tool_side: ToolSide,
+    /// Worker threads (natively; wasm uses one). Default 0: one per available core. The
+    /// result does not depend on it.
+    pub threads: usize,
 }
 
 impl Default for VerifyOptions {
@@ -76,6 +79,7 @@ impl Default for VerifyOptions {
             scallop_mm: 0.01,
             gouge_tolerance_mm: 0.0005,
             tool_side: ToolSide::Auto,
+            threads: 0,
         }
     }
 }
@@ -98,6 +102,11 @@ impl VerifyOptions {
     /// Sets the gouge tolerance (mm).
     pub fn with_gouge_tolerance(mut self, mm: f64) -> Self {
         self.gouge_tolerance_mm = mm;
+        self
+    }
+    /// Sets the number of worker threads (0: one per core).
+    pub fn with_threads(mut self, n: usize) -> Self {
+        self.threads = n;
         self
     }
     /// Sets the tool side.
@@ -215,6 +224,40 @@ pub struct Verification {
 pub fn verify(surface: &Surface, path: &CutterPath, opts: &VerifyOptions) -> Result<Verification> {
     opts.validate()?;
     Ok(engine::run(surface, path, opts, None))
+}
+
+/// Most rounds of [`verify_to_bound`].
+const BOUND_ROUNDS: usize = 4;
+/// Extra samples asked for beyond what the bound's fall with the spacing squared predicts.
+const BOUND_SAFETY: f64 = 1.1;
+
+/// As [`verify`], with as many samples as it takes for `error_bound_mm ≤ target_mm`:
+/// starting from `opts.samples`, the count grows in proportion to the bound's excess (the
+/// bound falls with the square of the spacing, so with the number of samples), for at most
+/// a few rounds; the result says what was reached.
+pub fn verify_to_bound(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    target_mm: f64,
+) -> Result<Verification> {
+    if !(target_mm.is_finite() && target_mm > 0.0) {
+        return Err(Error::param(
+            "error_bound_mm",
+            format!("the target bound must be a positive number of mm, got {target_mm}"),
+        ));
+    }
+    let mut o = opts.clone();
+    let mut v = verify(surface, path, &o)?;
+    for _ in 1..BOUND_ROUNDS {
+        if v.error_bound_mm <= target_mm || o.samples >= MAX_SAMPLES {
+            break;
+        }
+        let grow = (v.error_bound_mm / target_mm * BOUND_SAFETY).max(1.5);
+        o.samples = ((o.samples as f64 * grow).ceil() as usize).min(MAX_SAMPLES);
+        v = verify(surface, path, &o)?;
+    }
+    Ok(v)
 }
 
 /// As [`verify`], and the heat map: one value per vertex of `mesh` (a tessellation of

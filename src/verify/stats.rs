@@ -5,25 +5,24 @@
 const BINS: usize = 4096;
 
 /// The smallest value `v` such that values `≤ v` carry at least the fraction `q` of the total
-/// weight. `None` for no positive weight.
-pub fn weighted_quantile(values: &[(f64, f64)], q: f64) -> Option<f64> {
-    let total: f64 = values.iter().map(|&(_, w)| w).sum();
+/// weight, over `(value, weight)` pairs given in chunks. `None` for no positive weight.
+pub fn weighted_quantile(chunks: &[Vec<(f64, f64)>], q: f64) -> Option<f64> {
+    let values = || chunks.iter().flatten();
+    let total: f64 = values().map(|&(_, w)| w).sum();
     if !(total > 0.0) {
         return None;
     }
     let target = q.clamp(0.0, 1.0) * total;
-    let (lo, hi) = values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &(v, _)| {
-            (a.min(v), b.max(v))
-        });
+    let (lo, hi) = values().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &(v, _)| {
+        (a.min(v), b.max(v))
+    });
     if !(hi > lo) {
         return Some(lo);
     }
     let scale = BINS as f64 / (hi - lo);
     let bin = |v: f64| (((v - lo) * scale) as usize).min(BINS - 1);
     let mut weights = vec![0.0; BINS];
-    for &(v, w) in values {
+    for &(v, w) in values() {
         weights[bin(v)] += w;
     }
     let mut below = 0.0;
@@ -35,11 +34,7 @@ pub fn weighted_quantile(values: &[(f64, f64)], q: f64) -> Option<f64> {
         }
         below += w;
     }
-    let mut inside: Vec<(f64, f64)> = values
-        .iter()
-        .copied()
-        .filter(|&(v, _)| bin(v) == pick)
-        .collect();
+    let mut inside: Vec<(f64, f64)> = values().copied().filter(|&(v, _)| bin(v) == pick).collect();
     inside.sort_by(|a, b| a.0.total_cmp(&b.0));
     for &(v, w) in &inside {
         below += w;
@@ -77,11 +72,12 @@ mod tests {
                     break;
                 }
             }
-            let got = weighted_quantile(&values, q).unwrap();
+            let chunks: Vec<Vec<(f64, f64)>> = values.chunks(777).map(|c| c.to_vec()).collect();
+            let got = weighted_quantile(&chunks, q).unwrap();
             assert!((got - expect).abs() <= 1e-12, "q {q}: {got} vs {expect}");
         }
         assert_eq!(
-            weighted_quantile(&[(2.0, 1.0), (2.0, 3.0)], 0.95),
+            weighted_quantile(&[vec![(2.0, 1.0)], vec![(2.0, 3.0)]], 0.95),
             Some(2.0)
         );
         assert_eq!(weighted_quantile(&[], 0.5), None);
