@@ -111,7 +111,11 @@ fn gcode_from_plan_verifies_like_the_planned_path() {
     ]))
     .unwrap();
     let b: serde_json::Value = serde_json::from_str(&out).unwrap();
-    assert!(num(&b, "error_bound_mm") <= 0.004, "{}", b["error_bound_mm"]);
+    assert!(
+        num(&b, "error_bound_mm") <= 0.004,
+        "{}",
+        b["error_bound_mm"]
+    );
     assert!(num(&b, "samples") > 20000.0);
 }
 
