@@ -140,7 +140,7 @@ impl<'a> Probe<'a> {
         }
         // The point was swept: follow overlapping capsules downwards to the deepest point of
         // the swept region connected to it.
-        let mut lo = -self.radius;
+        let mut lo = -near;
         loop {
             self.gather(p, n, lo, 0.0);
             let mut deepest: Option<(u32, Span)> = None;
