@@ -12,10 +12,6 @@ const MAX_CELLS: usize = 1 << 22;
 /// Relative slack on the registration distance (dimensionless).
 const SLACK: f64 = 1e-9;
 
-fn cell_size(index: &CapsuleIndex) -> f64 {
-    index.cell_mm
-}
-
 /// Cells and the capsules in them (compressed rows).
 #[derive(Debug, Clone)]
 pub struct CapsuleIndex {
@@ -29,7 +25,7 @@ pub struct CapsuleIndex {
 
 impl CapsuleIndex {
     /// Indexes the capsules of radius `radius` that reach into `region`, on cells of about
-    /// `cell_mm` (coarser if the region would need more than [`MAX_CELLS`]).
+    /// `cell_mm` (coarser if the region would need more than `MAX_CELLS` cells).
     pub fn build(capsules: &[Capsule], radius: f64, region: &Aabb, cell_mm: f64) -> Self {
         let size = region.size();
         let mut cell = cell_mm;
@@ -60,14 +56,15 @@ impl CapsuleIndex {
                 index.cell_range(&lo, &hi)
             })
             .collect();
-        let near = |c: &Capsule, cell: usize| {
-            let x = cell % dims[0];
-            let y = (cell / dims[0]) % dims[1];
-            let z = cell / (dims[0] * dims[1]);
+        let origin = index.origin;
+        let near = |c: &Capsule, cell_index: usize| {
+            let x = cell_index % dims[0];
+            let y = (cell_index / dims[0]) % dims[1];
+            let z = cell_index / (dims[0] * dims[1]);
             let centre = Point3::new(
-                index.origin[0] + (x as f64 + 0.5) * cell_size(&index),
-                index.origin[1] + (y as f64 + 0.5) * cell_size(&index),
-                index.origin[2] + (z as f64 + 0.5) * cell_size(&index),
+                origin[0] + (x as f64 + 0.5) * cell,
+                origin[1] + (y as f64 + 0.5) * cell,
+                origin[2] + (z as f64 + 0.5) * cell,
             );
             (c.closest_on_axis(&centre) - centre).norm_squared() <= reach2
         };
@@ -221,5 +218,59 @@ impl CapsuleIndex {
     /// Edge length of a cell (mm).
     pub fn cell_mm(&self) -> f64 {
         self.cell_mm
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Vector3;
+
+    /// Every capsule a query segment meets is visited, whatever the segment's direction,
+    /// length and position relative to the cells.
+    #[test]
+    fn walk_visits_every_capsule_the_segment_meets() {
+        let mut seed = 4242u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let r = 0.4;
+        let mut capsules = Vec::new();
+        for _ in 0..400 {
+            let a = Point3::new(10.0 * rnd(), 10.0 * rnd(), 3.0 * rnd());
+            let d = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.2 * (rnd() - 0.5)) * 3.0;
+            capsules.push(Capsule::new(a, a + d));
+        }
+        let region = Aabb {
+            min: [-1.0, -1.0, -1.0],
+            max: [11.0, 11.0, 4.0],
+        };
+        for cell in [0.2, 0.5, 1.3] {
+            let index = CapsuleIndex::build(&capsules, r, &region, cell);
+            let mut seen = vec![0u32; capsules.len()];
+            let mut met = 0;
+            for q in 1..=2000u32 {
+                let p = Point3::new(10.0 * rnd(), 10.0 * rnd(), 3.0 * rnd());
+                let n = Vector3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize();
+                let (lo, hi) = (-2.0 * rnd(), 2.0 * rnd());
+                let mut visited = Vec::new();
+                index.visit(&(p + n * lo), &(p + n * hi), &mut seen, q, |i| {
+                    visited.push(i)
+                });
+                for (i, c) in capsules.iter().enumerate() {
+                    if c.interval(r, &p, &n, lo, hi).is_some() {
+                        met += 1;
+                        assert!(
+                            visited.contains(&(i as u32)),
+                            "cell {cell}: capsule {i} met by query {q} but not visited"
+                        );
+                    }
+                }
+            }
+            assert!(met > 500, "{met} meetings tested");
+        }
     }
 }

@@ -175,7 +175,8 @@ pub struct PatchVerification {
     pub gouge_count: usize,
     /// Fraction of the area overcut deeper than the gouge tolerance.
     pub gouge_fraction: f64,
-    /// Upper bound of (true − sampled) maximum scallop (mm).
+    /// Upper bound of (true − sampled) maximum scallop (mm), over the cells of four
+    /// neighbouring samples the tool reached (where some were not, the area is uncut anyway).
     pub scallop_error_bound_mm: f64,
     /// Depth of the shallowest gouge the samples could miss, and the most by which the
     /// deepest gouge can exceed `max_gouge_mm` (mm).

@@ -177,3 +177,85 @@ impl<'a> Probe<'a> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Aabb;
+
+    /// The measurement equals a brute force over every capsule: the first entry above the
+    /// point, or the bottom of the swept region containing it.
+    #[test]
+    fn agrees_with_brute_force_over_all_capsules() {
+        let mut seed = 777u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let r = 0.5;
+        let mut capsules = Vec::new();
+        for _ in 0..300 {
+            let a = Point3::new(6.0 * rnd(), 6.0 * rnd(), r - 0.3 + 1.2 * rnd());
+            let d = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 * (rnd() - 0.5)) * 2.0;
+            capsules.push(Capsule::new(a, a + d));
+        }
+        let region = Aabb {
+            min: [-2.0, -2.0, -3.0],
+            max: [8.0, 8.0, 3.0],
+        };
+        let index = CapsuleIndex::build(&capsules, r, &region, 0.5 * r);
+        let mut probe = Probe::new(&capsules, &index, r, r, 10.0);
+        let (mut gouges, mut left, mut unreached) = (0, 0, 0);
+        for _ in 0..3000 {
+            let p = Point3::new(6.0 * rnd(), 6.0 * rnd(), 0.0);
+            let n = Vector3::new(0.2 * (rnd() - 0.5), 0.2 * (rnd() - 0.5), 1.0).normalize();
+            let spans: Vec<Span> = capsules
+                .iter()
+                .filter_map(|c| c.interval(r, &p, &n, f64::NEG_INFINITY, f64::INFINITY))
+                .collect();
+            let expect = if spans.iter().any(|s| s.t_in <= 0.0 && s.t_out >= 0.0) {
+                let mut lo = 0.0f64;
+                loop {
+                    let next = spans
+                        .iter()
+                        .filter(|s| s.t_out >= lo && s.t_in <= lo)
+                        .map(|s| s.t_in)
+                        .fold(lo, f64::min);
+                    if next == lo {
+                        break;
+                    }
+                    lo = next;
+                }
+                gouges += 1;
+                Some(lo)
+            } else {
+                let first = spans
+                    .iter()
+                    .filter(|s| s.t_in > 0.0 && s.t_in <= r)
+                    .map(|s| s.t_in)
+                    .fold(f64::INFINITY, f64::min);
+                if first.is_finite() {
+                    left += 1;
+                    Some(first)
+                } else {
+                    unreached += 1;
+                    None
+                }
+            };
+            match (probe.measure(&p, &n), expect) {
+                (Material::Left { left_mm, governing }, Some(e)) => {
+                    assert_eq!(left_mm, e);
+                    assert_eq!(governing.hit.t_in, e);
+                }
+                (Material::Unreached, None) => {}
+                (got, e) => panic!("at {p:?}: measured {got:?}, brute force {e:?}"),
+            }
+        }
+        assert!(
+            gouges > 100 && left > 100 && unreached > 10,
+            "{gouges} {left} {unreached}"
+        );
+    }
+}
