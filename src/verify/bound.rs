@@ -59,8 +59,9 @@ pub struct CellBound {
     /// Upper bound of the material left anywhere in the cell (mm); `reach` if it cannot be
     /// bounded below that.
     pub scallop_upper_mm: f64,
-    /// Depth of the shallowest gouge that samples of this spacing could miss (mm).
-    pub gouge_slack_mm: f64,
+    /// Upper bound of the deepest overcut anywhere in the cell (mm; at least the deepest
+    /// at its corners).
+    pub gouge_upper_mm: f64,
     /// Where in the cell (offsets in `u` and `v` from corner 0) the exact step put the
     /// maximum, if it ran: the cusp, to be measured there.
     pub argmax: Option<[f64; 2]>,
@@ -184,11 +185,47 @@ pub fn max_of_min_quadratics(
     best
 }
 
+/// A cell of the sample grid: its parameter size, and which of its edges lie on the patch
+/// boundary (order: `v = v0` (corners 0, 1), `u = u1` (1, 3), `v = v1` (2, 3), `u = u0`
+/// (0, 2)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellFrame {
+    pub du: f64,
+    pub dv: f64,
+    pub boundary: [bool; 4],
+}
+
+/// Maximum over `t` in `[0, len]` of `min(a + ½ h t², b + ½ h (len − t)²)`.
+fn max_of_min_parabolas(a: f64, b: f64, len: f64, h: f64) -> f64 {
+    let q = 0.5 * h * len * len;
+    let mut best = a.min(b + q).max((a + q).min(b));
+    if h > 0.0 && len > 0.0 {
+        let t = 0.5 * len - (a - b) / (h * len);
+        if (0.0..=len).contains(&t) {
+            best = best.max(a + 0.5 * h * t * t);
+        }
+    }
+    best
+}
+
 /// Bounds of the cell with corners `c` (order (0,0), (du,0), (0,dv), (du,dv)) for a ball
 /// of radius `r`. Material beyond `reach` is not scallop (the tool never came near), so the
-/// scallop bound is capped there. Cells whose bound cannot exceed `best` skip the exact
-/// step and return a cheaper bound that is still `≤ best`.
-pub fn cell_bound(c: &[&Corner; 4], du: f64, dv: f64, r: f64, reach: f64, best: f64) -> CellBound {
+/// scallop bound is capped there. Cells whose bounds cannot exceed `best` (scallop, gouge)
+/// skip the exact step and return cheaper bounds that are still no larger than `best`.
+///
+/// Gouges: the bottom `x*` of a gouge of depth `D` by any capsule `j` (whether or not it
+/// governs a corner) is a critical point of its depth, and its curvature is bounded by `H`
+/// there, so every corner sees `−h_k ≥ −e_j(x_k) ≥ D − ½ δ_kᵀHδ_k`: `D` is at most
+/// `max_x min_k (−h_k + ½ δ_kᵀHδ_k)`. On the patch boundary the bottom may have a slope
+/// across the edge; along the edge it has none, so the edge's two corners bound it.
+pub fn cell_bound(
+    c: &[&Corner; 4],
+    frame: &CellFrame,
+    r: f64,
+    reach: f64,
+    best: [f64; 2],
+) -> CellBound {
+    let CellFrame { du, dv, boundary } = *frame;
     let diam = (c[0].point - c[3].point)
         .norm()
         .max((c[1].point - c[2].point).norm());
@@ -197,20 +234,36 @@ pub fn cell_bound(c: &[&Corner; 4], du: f64, dv: f64, r: f64, reach: f64, best: 
     let base = 1.0 / r + kappa;
     let quarter = [0.25 * du * du, 0.25 * dv * dv];
 
-    // Gouges: the deepest point of a dipping ball has zero slope and the ball is nearly
-    // level there, so from it the nearest sample (at most half a cell away in u and in v)
-    // sees at most ½ δᵀHδ less depth.
-    let k0 = {
-        let half = 0.5 * diam;
-        second_derivative_bound(r, kappa, r - base * half * half, 0.0)
-    };
+    // Gouges: near its bottom a dipping ball is nearly level (it rises by less than
+    // base·diam² over the cell), which bounds its curvature there.
+    let k0 = second_derivative_bound(r, kappa, r - base * diam * diam, 0.0);
     let h0 = remainder(c, k0, k0 * diam);
-    let gouge_slack_mm = 0.5 * (h0[0] * quarter[0] + h0[1] * quarter[1]);
+    let depths = [0, 1, 2, 3].map(|i| -c[i].left_mm);
+    let deepest = depths.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let cheap_gouge = deepest + 0.5 * (h0[0] * quarter[0] + h0[1] * quarter[1]);
+    let gouge_upper_mm = if cheap_gouge <= best[1] {
+        cheap_gouge
+    } else {
+        let mut g = max_of_min_quadratics(depths, [[0.0; 2]; 4], du, dv, h0).0;
+        for (edge, &on) in boundary.iter().enumerate() {
+            if on {
+                let (a, b, len, h) = match edge {
+                    0 => (depths[0], depths[1], du, h0[0]),
+                    1 => (depths[1], depths[3], dv, h0[1]),
+                    2 => (depths[2], depths[3], du, h0[0]),
+                    _ => (depths[0], depths[2], dv, h0[1]),
+                };
+                g = g.max(max_of_min_parabolas(a, b, len, h));
+            }
+        }
+        g
+    };
+    let best = best[0];
 
     if c.iter().any(|c| !(c.w_mm > 0.0)) {
         return CellBound {
             scallop_upper_mm: reach,
-            gouge_slack_mm,
+            gouge_upper_mm,
             argmax: None,
         };
     }
@@ -244,7 +297,7 @@ pub fn cell_bound(c: &[&Corner; 4], du: f64, dv: f64, r: f64, reach: f64, best: 
             };
             return CellBound {
                 scallop_upper_mm: upper.min(reach),
-                gouge_slack_mm,
+                gouge_upper_mm,
                 argmax,
             };
         }
@@ -252,7 +305,7 @@ pub fn cell_bound(c: &[&Corner; 4], du: f64, dv: f64, r: f64, reach: f64, best: 
     }
     CellBound {
         scallop_upper_mm: reach,
-        gouge_slack_mm,
+        gouge_upper_mm,
         argmax: None,
     }
 }
@@ -362,6 +415,27 @@ mod tests {
             }
         }
         best
+    }
+
+    #[test]
+    fn parabola_envelope_maximum() {
+        for (a, b, len, h) in [
+            (0.0, 0.0, 1.0, 2.0),
+            (0.3, -0.1, 0.5, 4.0),
+            (-1.0, 0.2, 0.1, 1.0),
+        ] {
+            let brute = (0..=100_000)
+                .map(|i| {
+                    let t = len * i as f64 / 100_000.0;
+                    (a + 0.5 * h * t * t).min(b + 0.5 * h * (len - t).powi(2))
+                })
+                .fold(f64::NEG_INFINITY, f64::max);
+            let exact = max_of_min_parabolas(a, b, len, h);
+            assert!(
+                exact >= brute - 1e-15 && exact - brute < 1e-9,
+                "{exact} vs {brute}"
+            );
+        }
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! parallel natively, in a fixed order so that results do not depend on the thread count),
 //! cell bounds, and the summary.
 
-use super::bound::{cell_bound, second_derivative_bound, Corner};
+use super::bound::{cell_bound, second_derivative_bound, CellFrame, Corner};
 use super::capsule::Capsule;
 use super::heatmap::{worse, HeatMap};
 use super::index::CapsuleIndex;
@@ -67,7 +67,8 @@ struct Acc {
     upper: Option<f64>,
     /// Extra measurements at located cusps.
     refined: usize,
-    gouge_slack: f64,
+    /// Upper bound of the deepest gouge over the cells (mm).
+    gouge_upper: Option<f64>,
     spacing: f64,
     /// (scallop, area weight) of every reached sample, one chunk per band.
     values: Vec<Vec<(f64, f64)>>,
@@ -89,7 +90,7 @@ impl Acc {
         self.max_gouge = self.max_gouge.max(o.max_gouge);
         self.upper = max_opt(self.upper, o.upper);
         self.refined += o.refined;
-        self.gouge_slack = self.gouge_slack.max(o.gouge_slack);
+        self.gouge_upper = max_opt(self.gouge_upper, o.gouge_upper);
         self.spacing = self.spacing.max(o.spacing);
         self.values.extend(o.values);
     }
@@ -341,8 +342,16 @@ fn band(
                 if c.iter().any(|c| !c.reached) {
                     continue;
                 }
-                let best = acc.upper.unwrap_or(f64::NEG_INFINITY);
-                let b = cell_bound(&c, du, dv, r, ctx.reach, best);
+                let best = [
+                    acc.upper.unwrap_or(f64::NEG_INFINITY),
+                    acc.gouge_upper.unwrap_or(f64::NEG_INFINITY),
+                ];
+                let frame = CellFrame {
+                    du,
+                    dv,
+                    boundary: [j == 1, i + 2 == nu, j + 1 == nv, i == 0],
+                };
+                let b = cell_bound(&c, &frame, r, ctx.reach, best);
                 acc.upper = max_opt(acc.upper, Some(b.scallop_upper_mm));
                 // Measure at the cusp the bound located, where it could raise the maximum.
                 if let Some([x, y]) = b.argmax {
@@ -358,7 +367,7 @@ fn band(
                         }
                     }
                 }
-                acc.gouge_slack = acc.gouge_slack.max(b.gouge_slack_mm);
+                acc.gouge_upper = max_opt(acc.gouge_upper, Some(b.gouge_upper_mm));
             }
         }
         std::mem::swap(&mut prev, &mut row);
@@ -554,7 +563,9 @@ fn summarise(patch: u32, grid: [usize; 2], acc: &Acc) -> PatchVerification {
     let frac = |a: f64| if acc.area > 0.0 { a / acc.area } else { 0.0 };
     let max_scallop = acc.max_left.map_or(0.0, |m| m.max(0.0));
     let scallop_bound = acc.upper.map_or(0.0, |u| (u - max_scallop).max(0.0));
-    let gouge_bound = acc.gouge_slack;
+    let gouge_bound = acc
+        .gouge_upper
+        .map_or(0.0, |g| (g - acc.max_gouge.max(0.0)).max(0.0));
     PatchVerification {
         patch,
         samples: acc.samples,

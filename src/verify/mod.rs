@@ -178,8 +178,8 @@ pub struct PatchVerification {
     /// Upper bound of (true − sampled) maximum scallop (mm), over the cells of four
     /// neighbouring samples the tool reached (where some were not, the area is uncut anyway).
     pub scallop_error_bound_mm: f64,
-    /// Depth of the shallowest gouge the samples could miss, and the most by which the
-    /// deepest gouge can exceed `max_gouge_mm` (mm).
+    /// The most by which the deepest gouge can exceed `max_gouge_mm` (mm), hidden gouges
+    /// between samples included.
     pub gouge_error_bound_mm: f64,
     /// The larger of the two bounds (mm).
     pub error_bound_mm: f64,
