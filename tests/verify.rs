@@ -533,3 +533,49 @@ fn results_do_not_depend_on_threads() {
         hb.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn a_gouge_hidden_between_samples_is_within_the_bound() {
+    // A short, shallow dip whose whole footprint lies between samples: no sample sees it,
+    // so the stated bound must cover it.
+    let (w, r, g, dip, half) = (4.0, 0.5, 0.25, 0.0008, 0.02);
+    let s = plane(w);
+    let mut pts = plane_passes(
+        Point3::new(0.0, 0.0, r),
+        Vector3::x(),
+        Vector3::y(),
+        g,
+        17,
+        w,
+        1.0,
+    );
+    // Pass 8 (y = 2 mm) runs from x = −1 to x = 5; samples every 4/41 mm miss (2, 2).
+    let x_m = 2.0;
+    pts.splice(
+        17..17,
+        [
+            Point3::new(x_m - half, 2.0, r),
+            Point3::new(x_m, 2.0, r - dip),
+            Point3::new(x_m + half, 2.0, r),
+        ],
+    );
+    let q = 41;
+    let v = verify::verify(
+        &s,
+        &path(r, &pts),
+        &VerifyOptions::default()
+            .with_samples((q + 1) * (q + 1))
+            .with_gouge_tolerance(0.0),
+    )
+    .unwrap();
+    println!(
+        "hidden dip {dip} mm: seen {:.6} mm, bound {:.6} mm",
+        v.max_gouge_mm, v.gouge_error_bound_mm
+    );
+    assert!(
+        v.max_gouge_mm < 1e-9,
+        "the dip is hidden: {}",
+        v.max_gouge_mm
+    );
+    assert!(dip <= v.max_gouge_mm + v.gouge_error_bound_mm);
+}
