@@ -281,11 +281,13 @@ fn band(
     let mut values: Vec<(f64, f64)> = Vec::new();
     let mut prev: Vec<Sample> = Vec::new();
     let mut row: Vec<Sample> = Vec::with_capacity(nu);
+    // Grid coordinates by division, so that the last row and column are exactly 1.
+    let at = |k: usize, n: usize| k as f64 / (n - 1) as f64;
     for j in j0..=j1 {
-        let v = j as f64 * dv;
+        let v = at(j, nv);
         row.clear();
         for i in 0..nu {
-            row.push(measure(ctx, probe, face, i as f64 * du, v));
+            row.push(measure(ctx, probe, face, at(i, nu), v));
         }
         if j > j0 || own_first {
             let wv = if j == 0 || j == nv - 1 { 0.5 } else { 1.0 };
@@ -319,7 +321,7 @@ fn band(
                 }
                 acc.max_gouge = acc.max_gouge.max(-left);
                 if left < 0.0 && deepest.is_none_or(|(d, ..)| left < d) {
-                    deepest = Some((left, i as f64 * du, v));
+                    deepest = Some((left, at(i, nu), v));
                 }
                 let scallop = left.max(0.0);
                 acc.scallop_area += scallop * w;
@@ -356,10 +358,7 @@ fn band(
                 // Measure at the cusp the bound located, where it could raise the maximum.
                 if let Some([x, y]) = b.argmax {
                     if acc.max_left.is_none_or(|m| b.scallop_upper_mm > m) {
-                        let (u, v) = (
-                            (i as f64 * du + x).min(1.0),
-                            ((j - 1) as f64 * dv + y).min(1.0),
-                        );
+                        let (u, v) = ((at(i, nu) + x).min(1.0), (at(j - 1, nv) + y).min(1.0));
                         let s = measure(ctx, probe, face, u, v);
                         if s.corner.reached {
                             acc.max_left = max_opt(acc.max_left, Some(s.corner.left_mm));
