@@ -151,8 +151,10 @@ fn grids(surface: &Surface, samples: usize) -> Vec<FaceGrid> {
                 samples as f64 / sizes.len() as f64
             };
             let aspect = if lu > 0.0 && lv > 0.0 { lu / lv } else { 1.0 };
-            let nu = (share * aspect).sqrt().round().max(2.0) as usize;
-            let nv = (share / nu as f64).round().max(2.0) as usize;
+            // At least 2 × 2, and no more than its share even for a sliver of a patch.
+            let most = (0.5 * share).max(2.0);
+            let nu = (share * aspect).sqrt().round().clamp(2.0, most) as usize;
+            let nv = (share / nu as f64).round().clamp(2.0, most) as usize;
             FaceGrid { nu, nv }
         })
         .collect()
