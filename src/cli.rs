@@ -2,7 +2,7 @@
 //! the page uses. Returns the text to print so that tests can run it in-process.
 
 use crate::error::{Error, Result};
-use crate::machine::{self, JobInfo};
+use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions};
 use crate::verify::{self, CutterPath, VerifyOptions};
@@ -12,12 +12,19 @@ const USAGE: &str = "usage:
   tspath info MODEL
   tspath sample --list
   tspath sample NAME -o FILE.json
+  tspath export MODEL -o FILE.stl|FILE.obj [--chordal MM]
   tspath plan MODEL [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
+              [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [-o OUT.nc] [--report REPORT.json] [--verify [--verify-samples N]]
+  tspath machine --list
+  tspath machine NAME [-o FILE.json]
   tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
-              [--scallop MM] [--gouge-tolerance MM]
+              [--scallop MM] [--gouge-tolerance MM] [--machine NAME|FILE.json] [--dialect NAME]
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
-verify simulates the ball-end cut of a G-code program (as `plan` writes it) or of a
+--machine is a built-in machine (default 3-axis) or a machine JSON file (start from
+`tspath machine NAME -o FILE.json`); --dialect is linuxcnc (default), linuxcnc-tcp, fanuc,
+heidenhain, siemens or plain; --units mm (default) or inch.
+verify simulates the ball-end cut of a program (read for --machine and --dialect) or of a
 tspath-cl JSON tool path and prints the scallops and gouges it leaves as JSON; --bound
 raises the sample count until the stated error bound is within MM.
 ";
@@ -33,6 +40,8 @@ pub fn run(args: &[String]) -> Result<String> {
         "sample" => sample(rest),
         "plan" => plan(rest),
         "verify" => verify_cmd(rest),
+        "export" => export(rest),
+        "machine" => machine_cmd(rest),
         "-h" | "--help" | "help" => Ok(USAGE.into()),
         other => Err(Error::Io(format!("unknown command `{other}`\n{USAGE}"))),
     }
@@ -155,6 +164,42 @@ fn sample(args: &[String]) -> Result<String> {
     }
 }
 
+fn export(args: &[String]) -> Result<String> {
+    let a = parse(args, &["-o", "--chordal"], &[])?;
+    let [model] = a.positional[..] else {
+        return Err(Error::Io(format!("export takes one MODEL\n{USAGE}")));
+    };
+    let out = a
+        .value("-o")
+        .ok_or_else(|| Error::Io(format!("export needs -o FILE.stl or FILE.obj\n{USAGE}")))?;
+    let chordal = a.number("--chordal")?.unwrap_or(0.01);
+    if !(chordal.is_finite() && chordal > 0.0) {
+        return Err(Error::param(
+            "chordal_mm",
+            format!("must be a positive number of mm, got {chordal}"),
+        ));
+    }
+    let m = load_model(model)?;
+    let t = m.tessellate(chordal);
+    let lower = out.to_ascii_lowercase();
+    if lower.ends_with(".stl") {
+        std::fs::write(out, crate::io::export::stl(&t, &m.name))
+            .map_err(|e| Error::Io(format!("cannot write {out}: {e}")))?;
+    } else if lower.ends_with(".obj") {
+        write_file(out, &crate::io::export::obj(&t, &m.name))?;
+    } else {
+        return Err(Error::Io(format!(
+            "{out}: the output must end in .stl or .obj"
+        )));
+    }
+    Ok(format!(
+        "{}: {} triangles, {} vertices, chordal tolerance {chordal} mm\n",
+        out,
+        t.indices.len() / 3,
+        t.positions.len() / 3
+    ))
+}
+
 fn plan(args: &[String]) -> Result<String> {
     let a = parse(
         args,
@@ -166,6 +211,9 @@ fn plan(args: &[String]) -> Result<String> {
             "-o",
             "--report",
             "--verify-samples",
+            "--machine",
+            "--dialect",
+            "--units",
         ],
         &["--verify"],
     )?;
@@ -173,6 +221,9 @@ fn plan(args: &[String]) -> Result<String> {
         return Err(Error::Io(format!("plan takes one MODEL\n{USAGE}")));
     };
     let m = load_model(model)?;
+    let mach = load_machine(a.value("--machine").unwrap_or("3-axis"))?;
+    let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
+    let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
     let mut opts = PlanOptions::default();
     if let Some(v) = a.number("--tool-radius")? {
         opts.tool_radius_mm = v;
@@ -190,14 +241,17 @@ fn plan(args: &[String]) -> Result<String> {
     let path = isoparametric::plan_zigzag(&m, &opts, &mut |_| true)?;
     let mut report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let gcode = machine::gcode_3axis(
+    let gcode = machine::post(
         &path,
         &opts,
         &JobInfo {
             model: m.name.clone(),
             strategy: "isoparametric".into(),
         },
-    );
+        &mach,
+        dialect,
+        units,
+    )?;
     let mut report_value = serde_json::to_value(&report).expect("report serialises");
     if a.has("--verify") {
         let mut vopts = VerifyOptions::default()
@@ -233,6 +287,8 @@ fn verify_cmd(args: &[String]) -> Result<String> {
             "--bound",
             "--scallop",
             "--gouge-tolerance",
+            "--machine",
+            "--dialect",
         ],
         &[],
     )?;
@@ -249,27 +305,24 @@ fn verify_cmd(args: &[String]) -> Result<String> {
     let m = load_model(model)?;
     let text = std::fs::read_to_string(path_file)
         .map_err(|e| Error::Io(format!("cannot read {path_file}: {e}")))?;
-    let mut opts = VerifyOptions::default();
-    let path = if text.trim_start().starts_with('{') {
-        CutterPath::from_cl_json(&text, r)?
+    let (path, mut opts) = if text.trim_start().starts_with('{') {
+        (
+            CutterPath::from_cl_json(&text, r)?,
+            VerifyOptions::default(),
+        )
     } else {
-        let prog = verify::gcode::read_3axis(&text)?;
-        if let Some(hr) = prog.header_tool_radius_mm {
-            if hr != r {
-                return Err(Error::param(
-                    "tool_radius_mm",
-                    format!("{path_file} says it was made for a ball-end radius {hr} mm, but --tool-radius is {r} mm"),
-                ));
-            }
-        }
+        let mach = load_machine(a.value("--machine").unwrap_or("3-axis"))?;
+        let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
+        let (path, header) =
+            verify::gcode::read_program(&text, r, &mach, dialect).map_err(|e| match e {
+                Error::InvalidParameter { name, message } => Error::InvalidParameter {
+                    name,
+                    message: format!("{path_file}: {message}"),
+                },
+                other => other,
+            })?;
         // The tolerances the program was made for, unless given.
-        if let Some(h) = prog.header_scallop_mm {
-            opts.scallop_mm = h;
-        }
-        if let Some(c) = prog.header_chordal_mm {
-            opts.gouge_tolerance_mm = c;
-        }
-        CutterPath::from_tool_tips(r, prog.tips)?
+        (path, header.options())
     };
     if let Some(h) = a.number("--scallop")? {
         opts.scallop_mm = h;
@@ -285,4 +338,44 @@ fn verify_cmd(args: &[String]) -> Result<String> {
         None => verify::verify(&m.surface, &path, &opts)?,
     };
     Ok(serde_json::to_string_pretty(&v).expect("verification serialises") + "\n")
+}
+
+/// A built-in machine by name, or a machine JSON file.
+pub fn load_machine(arg: &str) -> Result<machine::Machine> {
+    let path = std::path::Path::new(arg);
+    if machine::MACHINES.iter().any(|m| m.name == arg) {
+        machine::builtin(arg)
+    } else if path.exists() {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Io(format!("cannot read {arg}: {e}")))?;
+        machine::from_json(&text).map_err(|e| Error::Io(format!("{arg}: {e}")))
+    } else {
+        machine::builtin(arg)
+    }
+}
+
+fn machine_cmd(args: &[String]) -> Result<String> {
+    let a = parse(args, &["-o"], &["--list"])?;
+    if a.has("--list") {
+        let mut s = String::from("machines:\n");
+        for m in machine::MACHINES {
+            s.push_str(&format!("  {:<16} {}\n", m.name, m.description));
+        }
+        s.push_str("dialects:\n");
+        for (_, name, what) in machine::DIALECTS {
+            s.push_str(&format!("  {name:<16} {what}\n"));
+        }
+        return Ok(s);
+    }
+    let [name] = a.positional[..] else {
+        return Err(Error::Io(format!("machine takes one NAME\n{USAGE}")));
+    };
+    let json = machine::to_json(&machine::builtin(name)?);
+    match a.value("-o") {
+        Some(path) => {
+            write_file(path, &json)?;
+            Ok(String::new())
+        }
+        None => Ok(json),
+    }
 }

@@ -34,6 +34,11 @@ pub enum Error {
     #[error("degenerate geometry at {location}: {message}")]
     Degenerate { location: String, message: String },
 
+    /// A machine cannot do what the path asks (axis travel, unreachable tool axis, a rotary
+    /// jump forced by limits). `location` names the move.
+    #[error("machine error at {location}: {message}")]
+    Machine { location: String, message: String },
+
     /// No sample model of that name exists.
     #[error("unknown sample model `{0}` (see `tspath sample --list`)")]
     UnknownSample(String),

@@ -19,6 +19,7 @@ pub mod cli;
 pub mod error;
 pub mod geom;
 pub mod io;
+pub mod layout;
 pub mod machine;
 pub mod model;
 pub mod plan;

@@ -103,8 +103,8 @@ fn same_input_same_gcode() {
     };
     let a = isoparametric::plan_zigzag(&m, &opts, &mut |_| true).unwrap();
     let b = isoparametric::plan_zigzag(&m, &opts, &mut |_| true).unwrap();
-    let ga = tspath::machine::gcode_3axis(&a, &opts, &job);
-    assert_eq!(ga, tspath::machine::gcode_3axis(&b, &opts, &job));
+    let ga = tspath::machine::gcode_3axis(&a, &opts, &job).unwrap();
+    assert_eq!(ga, tspath::machine::gcode_3axis(&b, &opts, &job).unwrap());
     // Tool tip = ball centre − r·Z, so every cutting line puts the ball on the sphere.
     let c = dome_centre();
     let mut n = 0;

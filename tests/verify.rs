@@ -6,14 +6,15 @@
 #![allow(clippy::needless_range_loop)]
 
 use tspath::geom::{Point3, Vector3, Vector4};
-use tspath::model::samples;
+use tspath::model::{samples, Model};
 use tspath::plan::{isoparametric, stepover, MoveKind, PlanOptions};
 use tspath::surface::Surface;
 use tspath::tmesh::{ControlPoint, Scheme, TMesh};
 use tspath::verify::{self, CutterLocation, CutterPath, ToolSide, Verification, VerifyOptions};
 
-/// A clamped bicubic Bézier patch from a 4×4 homogeneous net (index `[j][i]`, `i` along u).
-fn bezier_surface(net: [[Vector4; 4]; 4]) -> Surface {
+/// A clamped bicubic Bézier patch from a 4×4 homogeneous net (index `[j][i]`, `i` along u),
+/// as a model (for its tessellation).
+fn bezier_model(net: [[Vector4; 4]; 4]) -> Model {
     let mut points = Vec::with_capacity(16);
     for row in &net {
         for h in row {
@@ -32,7 +33,11 @@ fn bezier_surface(net: [[Vector4; 4]; 4]) -> Surface {
         Scheme::TSpline,
     )
     .expect("a 4×4 clamped grid is a valid T-mesh");
-    Surface::try_from_tmesh(&mesh).expect("one Bézier face")
+    Model::try_new("patch", "json", "mm", mesh).expect("one Bézier face")
+}
+
+fn bezier_surface(net: [[Vector4; 4]; 4]) -> Surface {
+    bezier_model(net).surface
 }
 
 /// The plane z = 0 over `[0, w] × [0, w]`, uniformly parameterised.
@@ -59,6 +64,10 @@ fn elevate(h: [Vector4; 3]) -> [Vector4; 4] {
 /// A quarter of the cylinder `x² + z² = R²` (axis along y), angles −45°..45° from +z along
 /// u, `y` from 0 to `len` along v: a rational quadratic arc elevated to cubic, exact.
 fn quarter_cylinder(radius: f64, len: f64) -> Surface {
+    quarter_cylinder_model(radius, len).surface
+}
+
+fn quarter_cylinder_model(radius: f64, len: f64) -> Model {
     let a = std::f64::consts::FRAC_PI_4;
     // Arc in the (x, z) plane: (−sin a, cos a), (0, 1/cos a) with weight cos a, (sin a, cos a).
     let arc = [
@@ -76,7 +85,7 @@ fn quarter_cylinder(radius: f64, len: f64) -> Surface {
             net[j][i] = Vector4::new(h.x, y * h.w, h.z, h.w);
         }
     }
-    bezier_surface(net)
+    bezier_model(net)
 }
 
 fn path(r: f64, points: &[Point3]) -> CutterPath {
@@ -446,10 +455,10 @@ fn planned_paths_keep_their_scallop_and_do_not_gouge() {
 
 #[test]
 fn heat_map_follows_the_tessellation() {
-    use tspath::surface::tessellate::tessellate;
     let (big_r, len, r) = (5.0, 4.0, 0.5);
-    let s = quarter_cylinder(big_r, len);
-    let mesh = tessellate(&s, 0.001);
+    let model = quarter_cylinder_model(big_r, len);
+    let s = &model.surface;
+    let mesh = model.tessellate(0.001);
     let nverts = mesh.positions.len() / 3;
     assert!(nverts > 100, "{nverts} vertices");
     // Passes over the half of the arc with x < 0 only, one of them dipping by 0.02 mm.
@@ -466,7 +475,7 @@ fn heat_map_follows_the_tessellation() {
     let inward = Vector3::new(mid.x, 0.0, mid.z).normalize();
     pts.insert(k + 1, mid - inward * dip);
     let opts = VerifyOptions::default().with_samples(200_000);
-    let (v, heat) = verify::verify_with_heat_map(&s, &path(r, &pts), &opts, &mesh).unwrap();
+    let (v, heat) = verify::verify_with_heat_map(s, &path(r, &pts), &opts, &mesh).unwrap();
     assert_eq!(heat.len(), nverts);
     let cusp = {
         let d = big_r + r;
@@ -517,7 +526,7 @@ fn results_do_not_depend_on_threads() {
         .with_scallop(0.05);
     let p = isoparametric::plan_zigzag(&m, &opts, &mut |_| true).unwrap();
     let cp = CutterPath::from_toolpath(&p).unwrap();
-    let mesh = tspath::surface::tessellate::tessellate(&m.surface, 0.01);
+    let mesh = m.tessellate(0.01);
     let run = |threads| {
         let o = VerifyOptions::default()
             .with_samples(100_000)

@@ -103,3 +103,45 @@ fn impossible_parameters_throw() {
     assert!(msg.contains("scallop_mm"), "{msg}");
     assert!(js_message(model.tessellate(0.0).err().unwrap()).contains("chordal"));
 }
+
+#[wasm_bindgen_test]
+fn machine_dialect_and_units_choice() {
+    use tspath::wasm::{dialect_names, machine_json, machine_names};
+    assert!(machine_names().iter().any(|n| n == "table-table-ac"));
+    assert!(dialect_names().iter().any(|n| n == "heidenhain"));
+    let model = Model::sample("dome").unwrap();
+    let plan = model.plan(JsValue::UNDEFINED, None).unwrap();
+    let default = plan.gcode();
+    let fanuc = plan.gcode_for("table-table-ac", "fanuc", "inch").unwrap();
+    assert!(fanuc.contains("G20") && fanuc.contains("G43.4 H1") && fanuc.contains("(model: dome)"));
+    // A machine given as JSON text gives the same program as by name.
+    let json = machine_json("table-table-ac").unwrap();
+    assert_eq!(plan.gcode_for(&json, "fanuc", "inch").unwrap(), fanuc);
+    assert_eq!(plan.gcode_for("3-axis", "plain", "mm").unwrap(), default);
+    let msg = js_message(
+        plan.gcode_for("table-table-ac", "klingon", "mm")
+            .err()
+            .unwrap(),
+    );
+    assert!(msg.contains("klingon") && msg.contains("linuxcnc"), "{msg}");
+}
+
+#[wasm_bindgen_test]
+fn tsm_bytes_load_through_the_same_loader() {
+    // A real T-Splines file, detected from its `#TS0200` tag.
+    let bytes = include_bytes!("../../shared/fixtures/tsm/simple.tsm");
+    let model = Model::from_bytes(bytes, "simple").unwrap();
+    let summary = model.summary().unwrap();
+    assert_eq!(get(&summary, "format").as_string().as_deref(), Some("tsm"));
+    assert_eq!(
+        get(&summary, "units_read").as_string().as_deref(),
+        Some("millimeters (0.001 m)")
+    );
+    assert!(get(&summary, "patches").as_f64().unwrap() >= 1.0);
+    let broken = String::from_utf8_lossy(bytes).replace("e 0 0.5", "e 0 x");
+    let msg = js_message(Model::from_bytes(broken.as_bytes(), "x").err().unwrap());
+    assert!(
+        msg.contains("line ") && msg.contains("knot interval"),
+        "{msg}"
+    );
+}

@@ -55,7 +55,14 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
 
     // The G-code of the same plan gives the same picture (coordinates rounded to 0.1 µm).
     let g = model
-        .verify_gcode(&plan.gcode(), 2.0, &mesh, vopts.into())
+        .verify_gcode(
+            &plan.gcode(),
+            2.0,
+            "3-axis",
+            "linuxcnc",
+            &mesh,
+            vopts.into(),
+        )
         .unwrap();
     let gmax = get(&g.summary().unwrap(), "max_scallop_mm")
         .as_f64()
@@ -69,9 +76,30 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     assert!(msg.contains("samples"), "{msg}");
     let msg = js_message(
         model
-            .verify_gcode("G0 X0 Y0 Z0 B10\n", 2.0, &mesh, JsValue::UNDEFINED)
+            .verify_gcode(
+                "G0 X0 Y0 Z0\nG2 X1 Y1 I0 J1\n",
+                2.0,
+                "3-axis",
+                "linuxcnc",
+                &mesh,
+                JsValue::UNDEFINED,
+            )
             .err()
             .unwrap(),
     );
-    assert!(msg.contains("line 1") && msg.contains("rotary"), "{msg}");
+    assert!(msg.contains("line 2"), "{msg}");
+    let msg = js_message(
+        model
+            .verify_gcode(
+                &plan.gcode(),
+                1.0,
+                "3-axis",
+                "linuxcnc",
+                &mesh,
+                JsValue::UNDEFINED,
+            )
+            .err()
+            .unwrap(),
+    );
+    assert!(msg.contains("radius 2 mm"), "{msg}");
 }

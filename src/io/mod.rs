@@ -1,10 +1,14 @@
 //! Readers and writers of model files. Readers turn bytes into a validated [`TMesh`]
 //! wrapped in a [`Model`]; they never evaluate the surface themselves.
 //!
-//! Formats: the project's JSON T-mesh ([`json`]). The format is detected from the content,
-//! not from a file name, so the page and the CLI accept the same bytes.
+//! Formats: the project's JSON T-mesh ([`json`]) and Autodesk T-Splines `.tsm` files
+//! ([`tsm`]). The format is detected from the content, not from a file name, so the page and
+//! the CLI accept the same bytes.
 
+pub mod export;
 pub mod json;
+pub mod obj;
+pub mod tsm;
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -74,9 +78,13 @@ pub fn load(bytes: &[u8], name: &str) -> Result<Model> {
             };
             Model::try_new(name, "json", &meta.units, mesh)
         }
-        f => Err(Error::Unsupported(format!(
-            "{} files are not readable by this build yet",
-            f.name()
-        ))),
+        Format::Obj => {
+            let text = String::from_utf8_lossy(bytes);
+            Model::try_new(name, "obj", "mm (assumed)", obj::read(&text)?)
+        }
+        Format::Tsm => {
+            let (mesh, meta) = tsm::read(bytes)?;
+            Model::try_new(name, "tsm", &meta.units_label(), mesh)
+        }
     }
 }

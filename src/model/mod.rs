@@ -7,6 +7,7 @@ pub mod samples;
 
 use crate::error::Result;
 use crate::geom::Aabb;
+use crate::layout::PatchLayout;
 use crate::surface::Surface;
 use crate::tmesh::TMesh;
 use serde::{Deserialize, Serialize};
@@ -21,6 +22,7 @@ pub struct Model {
     pub units_read: String,
     pub mesh: TMesh,
     pub surface: Surface,
+    pub layout: PatchLayout,
 }
 
 /// Counts and size of a model, as shown by `tspath info` and the page.
@@ -43,13 +45,54 @@ impl Model {
     /// Builds the surface of `mesh` and bundles it.
     pub fn try_new(name: &str, format: &str, units_read: &str, mesh: TMesh) -> Result<Self> {
         let surface = Surface::try_from_tmesh(&mesh)?;
+        let layout = PatchLayout::build(&mesh, &surface);
         Ok(Model {
+            layout,
             name: name.to_string(),
             format: format.to_string(),
             units_read: units_read.to_string(),
             mesh,
             surface,
         })
+    }
+
+    /// Watertight triangles within `chordal_mm` of the surface, with patch ids.
+    pub fn tessellate(&self, chordal_mm: f64) -> crate::surface::tessellate::Tessellation {
+        crate::surface::tessellate::tessellate(&self.mesh, &self.surface, &self.layout, chordal_mm)
+    }
+
+    /// Surface positions of the extraordinary points (mm), in vertex order.
+    pub fn extraordinary_positions(&self) -> Vec<crate::geom::Point3> {
+        let index: std::collections::HashMap<u32, usize> = self
+            .surface
+            .faces()
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.mesh_face, i))
+            .collect();
+        (0..self.mesh.vertex_count() as u32)
+            .filter(|&v| self.mesh.is_extraordinary(v))
+            .filter_map(|v| {
+                self.mesh.outgoing(v).into_iter().find_map(|h| {
+                    let e = self.mesh.he(h);
+                    let &fi = index.get(&e.face)?;
+                    let face = &self.mesh.faces()[e.face as usize];
+                    let s = e.offset
+                        / if e.side % 2 == 0 {
+                            face.width
+                        } else {
+                            face.height
+                        };
+                    let (u, v) = match e.side {
+                        0 => (s, 0.0),
+                        1 => (1.0, s),
+                        2 => (1.0 - s, 1.0),
+                        _ => (0.0, 1.0 - s),
+                    };
+                    Some(self.surface.subs(fi, u, v))
+                })
+            })
+            .collect()
     }
 
     /// Counts and bounding box.
@@ -67,7 +110,7 @@ impl Model {
                 .filter(|&v| self.mesh.is_extraordinary(v))
                 .count(),
             holes: self.mesh.boundary_loops().saturating_sub(1),
-            patches: self.surface.faces().len(),
+            patches: self.layout.len(),
             bbox_mm: self.surface.bbox(),
         }
     }

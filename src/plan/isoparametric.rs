@@ -24,11 +24,10 @@ struct PassPoint {
     normal: Vector3,
 }
 
-fn geom_at(face: &FaceSurface, u: f64, v: f64) -> Result<DiffGeom> {
-    DiffGeom::try_from_derivs(&face.derivs(u, v)).ok_or_else(|| Error::Degenerate {
-        location: format!("face {} at (u, v) = ({u:.6}, {v:.6})", face.mesh_face),
-        message: "the surface has no tangent plane here".into(),
-    })
+/// Fundamental forms at a point; `None` at a singular point (an extraordinary point's limit),
+/// where curvature is undefined and must not enter step computations.
+fn geom_at(face: &FaceSurface, u: f64, v: f64) -> Option<DiffGeom> {
+    DiffGeom::try_from_derivs(&face.derivs(u, v))
 }
 
 /// Point on the pass at fixed `w` (the across-parameter), moving parameter `t`.
@@ -46,7 +45,9 @@ fn required_step(face: &FaceSurface, dir: FeedDir, w: f64, opts: &PlanOptions) -
     for k in 0..SIDE_STEP_SAMPLES {
         let t = k as f64 / (SIDE_STEP_SAMPLES - 1) as f64;
         let (u, v) = at(dir, t, w);
-        let dg = geom_at(face, u, v)?;
+        let Some(dg) = geom_at(face, u, v) else {
+            continue;
+        };
         let kappa = stepover::cross_curvature(&dg, dir);
         let g =
             stepover::side_step(opts.scallop_mm, opts.tool_radius_mm, kappa).map_err(
@@ -76,7 +77,9 @@ fn predicted_between(
         for k in 0..SIDE_STEP_SAMPLES {
             let t = k as f64 / (SIDE_STEP_SAMPLES - 1) as f64;
             let (u, v) = at(dir, t, ww.min(1.0));
-            let dg = geom_at(face, u, v)?;
+            let Some(dg) = geom_at(face, u, v) else {
+                continue;
+            };
             let kappa = stepover::cross_curvature(&dg, dir);
             let g = stepover::physical_side_step(&dg, dir, dw);
             worst = worst.max(stepover::predicted_scallop(g, opts.tool_radius_mm, kappa));
@@ -127,10 +130,13 @@ fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
 
 fn pass_point(face: &FaceSurface, dir: FeedDir, t: f64, w: f64) -> Result<PassPoint> {
     let (u, v) = at(dir, t, w);
-    let dg = geom_at(face, u, v)?;
+    let normal = face.normal(u, v).ok_or_else(|| Error::Degenerate {
+        location: format!("face {} at (u, v) = ({u:.6}, {v:.6})", face.mesh_face),
+        message: "the surface has no tangent plane here or nearby".into(),
+    })?;
     Ok(PassPoint {
-        cc: dg.point,
-        normal: dg.normal,
+        cc: face.subs(u, v),
+        normal,
     })
 }
 

@@ -11,6 +11,7 @@ pub mod basis;
 pub mod bezier;
 pub mod diffgeom;
 mod extract;
+pub mod subdiv;
 pub mod tessellate;
 
 pub use bezier::{BezierPatch, SurfaceDerivs};
@@ -20,7 +21,25 @@ use crate::error::{Error, Result};
 use crate::geom::{Aabb, Point3, Vector3};
 use crate::tmesh::TMesh;
 
-/// One domain face of the surface in Bézier form: a grid of cells over `[0,1]²`.
+/// How a face is stored for evaluation.
+// A face that is one regular cell keeps it inline (the common case on subdivision cages).
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone)]
+pub enum FaceForm {
+    /// A grid of Bézier cells (T-spline faces, cut at every knot line crossing them).
+    Grid {
+        /// Cell boundaries in `u` and `v`, from 0 to 1.
+        u_breaks: Vec<f64>,
+        v_breaks: Vec<f64>,
+        /// Cells, row-major: index `j * (u_breaks.len() - 1) + i`.
+        cells: Vec<BezierPatch>,
+    },
+    /// A quadtree of Bézier cells from local Catmull–Clark subdivision (faces at and near
+    /// extraordinary points, and every face of a Catmull–Clark cage).
+    Tree(subdiv::Node),
+}
+
+/// One domain face of the surface in Bézier form.
 #[derive(Debug, Clone)]
 pub struct FaceSurface {
     /// The T-mesh face this comes from.
@@ -28,65 +47,96 @@ pub struct FaceSurface {
     /// Parametric width and height of the face in knot units.
     pub width: f64,
     pub height: f64,
-    /// Cell boundaries in `u` and `v`, from 0 to 1.
-    u_breaks: Vec<f64>,
-    v_breaks: Vec<f64>,
-    /// Cells, row-major: index `j * (u_breaks.len() - 1) + i`.
-    cells: Vec<BezierPatch>,
+    pub form: FaceForm,
+}
+
+fn locate(breaks: &[f64], x: f64) -> (usize, f64, f64) {
+    let n = breaks.len() - 1;
+    let i = breaks[1..n].partition_point(|&b| b <= x).min(n - 1);
+    let span = breaks[i + 1] - breaks[i];
+    (i, (x - breaks[i]) / span, 1.0 / span)
 }
 
 impl FaceSurface {
-    fn locate(breaks: &[f64], x: f64) -> (usize, f64, f64) {
-        let n = breaks.len() - 1;
-        let i = match breaks[1..n]
-            .binary_search_by(|b| b.partial_cmp(&x).unwrap_or(std::cmp::Ordering::Less))
-        {
-            Ok(k) => k + 1,
-            Err(k) => k,
-        };
-        let i = i.min(n - 1);
-        let span = breaks[i + 1] - breaks[i];
-        ((i), (x - breaks[i]) / span, 1.0 / span)
-    }
-
     /// Point and derivatives at `(u, v)` in `[0,1]²`.
     pub fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
-        let (i, tu, su) = Self::locate(&self.u_breaks, u);
-        let (j, tv, sv) = Self::locate(&self.v_breaks, v);
-        let nu = self.u_breaks.len() - 1;
-        self.cells[j * nu + i].derivs(tu, tv).scaled(su, sv)
+        match &self.form {
+            FaceForm::Grid {
+                u_breaks,
+                v_breaks,
+                cells,
+            } => {
+                let (i, tu, su) = locate(u_breaks, u);
+                let (j, tv, sv) = locate(v_breaks, v);
+                cells[j * (u_breaks.len() - 1) + i]
+                    .derivs(tu, tv)
+                    .scaled(su, sv)
+            }
+            FaceForm::Tree(node) => node.derivs(u, v),
+        }
     }
 
     /// Point at `(u, v)` in `[0,1]²`.
     pub fn subs(&self, u: f64, v: f64) -> Point3 {
-        let (i, tu, _) = Self::locate(&self.u_breaks, u);
-        let (j, tv, _) = Self::locate(&self.v_breaks, v);
-        let nu = self.u_breaks.len() - 1;
-        self.cells[j * nu + i].subs(tu, tv)
+        match &self.form {
+            FaceForm::Grid {
+                u_breaks,
+                v_breaks,
+                cells,
+            } => {
+                let (i, tu, _) = locate(u_breaks, u);
+                let (j, tv, _) = locate(v_breaks, v);
+                cells[j * (u_breaks.len() - 1) + i].subs(tu, tv)
+            }
+            FaceForm::Tree(node) => node.subs(u, v),
+        }
+    }
+
+    /// Unit normal at `(u, v)`; where the tangent plane degenerates (an extraordinary
+    /// point's limit), the normal of nearby points towards the face centre.
+    pub fn normal(&self, u: f64, v: f64) -> Option<Vector3> {
+        if let Some(g) = DiffGeom::try_from_derivs(&self.derivs(u, v)) {
+            return Some(g.normal);
+        }
+        NORMAL_PROBES.iter().find_map(|&t| {
+            let (uu, vv) = (u + (0.5 - u) * t, v + (0.5 - v) * t);
+            DiffGeom::try_from_derivs(&self.derivs(uu, vv)).map(|g| g.normal)
+        })
     }
 
     /// Number of Bézier cells.
     pub fn cell_count(&self) -> usize {
-        self.cells.len()
+        match &self.form {
+            FaceForm::Grid { cells, .. } => cells.len(),
+            FaceForm::Tree(node) => node.leaf_count(),
+        }
     }
 
-    /// The cells with their `[u0,u1]×[v0,v1]` ranges.
-    pub fn cells(&self) -> impl Iterator<Item = ([f64; 4], &BezierPatch)> {
-        let nu = self.u_breaks.len() - 1;
-        self.cells.iter().enumerate().map(move |(k, c)| {
-            let (i, j) = (k % nu, k / nu);
-            (
-                [
-                    self.u_breaks[i],
-                    self.u_breaks[i + 1],
-                    self.v_breaks[j],
-                    self.v_breaks[j + 1],
-                ],
-                c,
-            )
-        })
+    /// Calls `f` with every cell and its `[u0, u1, v0, v1]` range.
+    pub fn for_each_cell(&self, f: &mut dyn FnMut([f64; 4], &BezierPatch)) {
+        match &self.form {
+            FaceForm::Grid {
+                u_breaks,
+                v_breaks,
+                cells,
+            } => {
+                let nu = u_breaks.len() - 1;
+                for (k, c) in cells.iter().enumerate() {
+                    let (i, j) = (k % nu, k / nu);
+                    f(
+                        [u_breaks[i], u_breaks[i + 1], v_breaks[j], v_breaks[j + 1]],
+                        c,
+                    );
+                }
+            }
+            FaceForm::Tree(node) => node.for_each_leaf(f),
+        }
     }
 }
+
+/// Fractions of the way towards the face centre at which a normal is looked for when the
+/// surface is singular at the point asked (relative, dimensionless).
+const NORMAL_PROBES: [f64; 4] = [1e-9, 1e-7, 1e-5, 1e-3];
 
 /// The evaluable surface of a model: its domain faces in Bézier form.
 #[derive(Debug, Clone)]
@@ -105,14 +155,7 @@ impl Surface {
                 "no face has positive parametric area (all knot intervals zero?)".into(),
             ));
         }
-        let mut bbox = Aabb::empty();
-        for f in &faces {
-            for k in 0..=8 {
-                for l in 0..=8 {
-                    bbox.grow(&f.subs(k as f64 / 8.0, l as f64 / 8.0));
-                }
-            }
-        }
+        let bbox = extreme_box(&faces);
         Ok(Surface { faces, bbox })
     }
 
@@ -131,6 +174,11 @@ impl Surface {
         self.faces[face].derivs(u, v)
     }
 
+    /// Unit normal on domain face `face` (see [`FaceSurface::normal`]).
+    pub fn normal(&self, face: usize, u: f64, v: f64) -> Option<Vector3> {
+        self.faces[face].normal(u, v)
+    }
+
     /// `∂S/∂u` on domain face `face`.
     pub fn uder(&self, face: usize, u: f64, v: f64) -> Vector3 {
         self.derivs(face, u, v).su
@@ -141,8 +189,67 @@ impl Surface {
         self.derivs(face, u, v).sv
     }
 
-    /// Approximate bounding box of the surface (sampled, mm).
+    /// Bounding box of the surface (mm), located to about 1e-9 of the model size.
     pub fn bbox(&self) -> Aabb {
         self.bbox
     }
+}
+
+/// Samples per face side when looking for the extremes of the surface.
+const BOX_SAMPLES: usize = 9;
+/// Faces whose best sample is refined, per direction.
+const BOX_CANDIDATES: usize = 4;
+/// Rounds of local refinement around a candidate (each shrinks the search square by 4).
+const BOX_ROUNDS: usize = 14;
+
+/// Bounding box of the faces: coarse samples, then a shrinking local search around the best
+/// few candidates in each of the six directions.
+fn extreme_box(faces: &[FaceSurface]) -> Aabb {
+    let n = BOX_SAMPLES;
+    let grid = |k: usize| k as f64 / (n - 1) as f64;
+    let mut bbox = Aabb::empty();
+    // (value, face, u, v) of the best sample per face and direction.
+    let mut best: Vec<[(f64, usize, f64, f64); 6]> = Vec::with_capacity(faces.len());
+    for (fi, f) in faces.iter().enumerate() {
+        let mut b = [(f64::NEG_INFINITY, fi, 0.0, 0.0); 6];
+        for j in 0..n {
+            for i in 0..n {
+                let p = f.subs(grid(i), grid(j));
+                bbox.grow(&p);
+                for d in 0..6 {
+                    let val = if d < 3 { p[d] } else { -p[d - 3] };
+                    if val > b[d].0 {
+                        b[d] = (val, fi, grid(i), grid(j));
+                    }
+                }
+            }
+        }
+        best.push(b);
+    }
+    for d in 0..6 {
+        let mut cands: Vec<(f64, usize, f64, f64)> = best.iter().map(|b| b[d]).collect();
+        cands.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for &(_, fi, mut u, mut v) in cands.iter().take(BOX_CANDIDATES) {
+            let f = &faces[fi];
+            let mut half = 1.0 / (n - 1) as f64;
+            for _ in 0..BOX_ROUNDS {
+                let (mut bu, mut bv, mut bval) = (u, v, f64::NEG_INFINITY);
+                for a in -2i32..=2 {
+                    for c in -2i32..=2 {
+                        let uu = (u + half * a as f64 / 2.0).clamp(0.0, 1.0);
+                        let vv = (v + half * c as f64 / 2.0).clamp(0.0, 1.0);
+                        let p = f.subs(uu, vv);
+                        bbox.grow(&p);
+                        let val = if d < 3 { p[d] } else { -p[d - 3] };
+                        if val > bval {
+                            (bu, bv, bval) = (uu, vv, val);
+                        }
+                    }
+                }
+                (u, v) = (bu, bv);
+                half *= 0.25;
+            }
+        }
+    }
+    bbox
 }

@@ -1,7 +1,16 @@
-//! Triangle meshes of the surface for display and export: per face a grid fine enough for a
-//! chordal tolerance, with the patch id of every triangle.
+//! Watertight triangle meshes of the surface within a chordal tolerance, for display and
+//! export, with the patch of every triangle.
+//!
+//! Every mesh edge is sampled once, by a count that depends only on the edge, and the two
+//! faces beside it share those vertices; each face fills its inside with a grid fine enough
+//! for its own curvature and stitches the grid to its boundary samples with a strip. So no
+//! cracks open where faces of different sizes or T-junctions meet.
 
-use super::{DiffGeom, Surface};
+use super::{FaceSurface, Surface};
+use crate::geom::{Point3, Vector3};
+use crate::layout::PatchLayout;
+use crate::tmesh::TMesh;
+use std::collections::HashMap;
 
 /// Flat arrays ready for a GPU or an STL writer.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -12,78 +21,434 @@ pub struct Tessellation {
     pub normals: Vec<f32>,
     /// Three vertex indices per triangle, counter-clockwise seen from the normal side.
     pub indices: Vec<u32>,
-    /// Domain face (patch) of each triangle.
+    /// Patch of each triangle (index into the layout).
     pub patch_ids: Vec<u32>,
+    /// Domain face and `(u, v)` of each vertex, for tests and heat maps.
+    pub params: Vec<(u32, f64, f64)>,
 }
 
-/// Fewest and most segments along a face side.
-const MIN_SEGMENTS: usize = 2;
-const MAX_SEGMENTS: usize = 128;
-/// Samples per side used to estimate length and curvature.
+/// Fewest grid cells across a face each way (so its inner ring is a rectangle).
+const MIN_GRID: usize = 3;
+/// Most segments along one edge or across one face.
+const MAX_SEGMENTS: usize = 256;
+/// Iso-parameter lines of a face sampled to size its grid.
+const ISO_LINES: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+/// Samples per curve used to estimate its length and curvature.
 const PROBE: usize = 9;
+/// The sagitta formula is exact for circles; grids also twist, so segments are made this
+/// much shorter than it allows (dimensionless).
+const SAFETY: f64 = 0.7;
 
-/// Tessellates every face on a grid whose segments deviate from the surface by about
-/// `chordal_mm` or less.
-pub fn tessellate(surface: &Surface, chordal_mm: f64) -> Tessellation {
-    let mut t = Tessellation::default();
-    for (fi, face) in surface.faces().iter().enumerate() {
-        // Length and curvature of the iso-curves, sampled.
-        let mut len_u: f64 = 0.0;
-        let mut len_v: f64 = 0.0;
-        let mut k_max: f64 = 0.0;
-        for a in 0..PROBE {
-            let x = a as f64 / (PROBE - 1) as f64;
-            let mut lu = 0.0;
-            let mut lv = 0.0;
-            for b in 0..PROBE - 1 {
-                let y0 = b as f64 / (PROBE - 1) as f64;
-                let y1 = (b + 1) as f64 / (PROBE - 1) as f64;
-                lu += (face.subs(y1, x) - face.subs(y0, x)).norm();
-                lv += (face.subs(x, y1) - face.subs(x, y0)).norm();
-                let d = face.derivs(y0, x);
-                for (c1, c2) in [(d.su, d.suu), (d.sv, d.svv)] {
-                    let s = c1.norm();
-                    if s > 0.0 {
-                        k_max = k_max.max(c1.cross(&c2).norm() / (s * s * s));
+/// Segments needed along the curve `c(t)`, `t ∈ [0,1]`, for chordal tolerance `tol`:
+/// uniform in `t`, so sized for the fastest and most curved part of the curve.
+fn segments(c: &dyn Fn(f64) -> (Point3, Vector3, Vector3), tol: f64) -> usize {
+    let mut speed: f64 = 0.0;
+    let mut kmax: f64 = 0.0;
+    for i in 0..PROBE {
+        let (_, d1, d2) = c(i as f64 / (PROBE - 1) as f64);
+        let s = d1.norm();
+        speed = speed.max(s);
+        if s > 0.0 {
+            kmax = kmax.max(d1.cross(&d2).norm() / (s * s * s));
+        }
+    }
+    let seg = if kmax > 0.0 {
+        SAFETY * (8.0 * tol / kmax).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    ((speed / seg).ceil() as usize).clamp(1, MAX_SEGMENTS)
+}
+
+/// Rounds of measuring and refining a face's grid.
+const GRID_ROUNDS: usize = 4;
+
+/// Largest distance, along the normal, between a cell's centre on the surface and the
+/// average of its corners, over the `nu × nv` grid of a face.
+fn grid_deviation(face: &FaceSurface, nu: usize, nv: usize) -> f64 {
+    let p = |i: usize, j: usize| face.subs(i as f64 / nu as f64, j as f64 / nv as f64).coords;
+    let mut rows: Vec<Vec<Vector3>> = (0..=nv)
+        .map(|j| (0..=nu).map(|i| p(i, j)).collect())
+        .collect();
+    let mut worst: f64 = 0.0;
+    for j in 0..nv {
+        for i in 0..nu {
+            let (u, v) = ((i as f64 + 0.5) / nu as f64, (j as f64 + 0.5) / nv as f64);
+            let c = face.subs(u, v).coords;
+            let avg = (rows[j][i] + rows[j][i + 1] + rows[j + 1][i] + rows[j + 1][i + 1]) * 0.25;
+            let n = face.normal(u, v).unwrap_or_else(Vector3::z);
+            worst = worst.max((c - avg).dot(&n).abs());
+        }
+    }
+    rows.clear();
+    worst
+}
+
+/// Curve along face side at fixed `v` (u from 0 to 1) or fixed `u`.
+fn iso(
+    face: &FaceSurface,
+    along_u: bool,
+    w: f64,
+) -> impl Fn(f64) -> (Point3, Vector3, Vector3) + '_ {
+    move |t| {
+        let d = if along_u {
+            face.derivs(t, w)
+        } else {
+            face.derivs(w, t)
+        };
+        if along_u {
+            (d.point, d.su, d.suu)
+        } else {
+            (d.point, d.sv, d.svv)
+        }
+    }
+}
+
+/// Tessellates every domain face, watertight across faces, each edge of a triangle
+/// deviating from the surface by about `chordal_mm` or less.
+pub fn tessellate(
+    mesh: &TMesh,
+    surface: &Surface,
+    layout: &PatchLayout,
+    chordal_mm: f64,
+) -> Tessellation {
+    let faces = surface.faces();
+    let domain: HashMap<u32, usize> = faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (f.mesh_face, i))
+        .collect();
+    // Coincident vertices (ends of zero-length edges) share one id.
+    let nv = mesh.vertex_count();
+    let mut rep: Vec<u32> = (0..nv as u32).collect();
+    fn root(rep: &mut [u32], mut x: u32) -> u32 {
+        while rep[x as usize] != x {
+            rep[x as usize] = rep[rep[x as usize] as usize];
+            x = rep[x as usize];
+        }
+        x
+    }
+    for h in mesh.half_edges() {
+        if h.knot == 0.0 {
+            let (a, b) = (
+                root(&mut rep, h.origin),
+                root(&mut rep, mesh.he(h.next).origin),
+            );
+            rep[a.max(b) as usize] = a.min(b);
+        }
+    }
+    // Grid cells each face needs across u and v for its own curvature.
+    let grid: Vec<(usize, usize)> = faces
+        .iter()
+        .map(|face| {
+            let most = |along_u: bool| {
+                ISO_LINES
+                    .iter()
+                    .map(|&w| segments(&iso(face, along_u, w), chordal_mm))
+                    .max()
+                    .unwrap_or(1)
+            };
+            let (mut nu, mut nv) = (most(true), most(false));
+            // A twisted cell bends away from its flat triangles by about |S_uv·n|·Δu·Δv/4.
+            let mut twist: f64 = 0.0;
+            for &a in &ISO_LINES {
+                for &b in &ISO_LINES {
+                    let d = face.derivs(a, b);
+                    let n = d.su.cross(&d.sv);
+                    if n.norm() > 0.0 {
+                        twist = twist.max(d.suv.dot(&n).abs() / n.norm());
                     }
                 }
             }
-            len_u = len_u.max(lu);
-            len_v = len_v.max(lv);
+            let need = twist / (4.0 * SAFETY * SAFETY * chordal_mm);
+            if (nu * nv) as f64 <= need {
+                let f = (need / (nu * nv) as f64).sqrt();
+                nu = ((nu as f64 * f).ceil() as usize).min(MAX_SEGMENTS);
+                nv = ((nv as f64 * f).ceil() as usize).min(MAX_SEGMENTS);
+            }
+            let (mut nu, mut nv) = (nu.max(MIN_GRID), nv.max(MIN_GRID));
+            // Measure: the cells' centres against their corners' average, and refine where
+            // the estimate fell short (near extraordinary points the parameterisation bends).
+            for _ in 0..GRID_ROUNDS {
+                let dev = grid_deviation(face, nu, nv);
+                if dev <= SAFETY * chordal_mm || (nu >= MAX_SEGMENTS && nv >= MAX_SEGMENTS) {
+                    break;
+                }
+                let f = (dev / (SAFETY * chordal_mm)).sqrt() * 1.1;
+                nu = ((nu as f64 * f).ceil() as usize).min(MAX_SEGMENTS);
+                nv = ((nv as f64 * f).ceil() as usize).min(MAX_SEGMENTS);
+            }
+            (nu, nv)
+        })
+        .collect();
+    // Segment count per undirected edge: enough for the edge's own curve and for the grids
+    // of both faces beside it, so the strips between boundary and grid stay short.
+    let mut edge_segments: HashMap<(u32, u32), usize> = HashMap::new();
+    for (hi, h) in mesh.half_edges().iter().enumerate() {
+        if h.knot == 0.0 {
+            continue;
         }
-        let seg = if k_max > 0.0 {
-            (8.0 * chordal_mm / k_max).sqrt()
-        } else {
-            f64::INFINITY
+        if let Some(t) = h.twin {
+            if t < hi as u32 && domain.contains_key(&mesh.he(t).face) {
+                continue;
+            }
+        }
+        let Some(&d) = domain.get(&h.face) else {
+            continue;
         };
-        let count = |len: f64| ((len / seg).ceil() as usize).clamp(MIN_SEGMENTS, MAX_SEGMENTS);
-        let (nu, nv) = (count(len_u), count(len_v));
-        let base = (t.positions.len() / 3) as u32;
-        for j in 0..=nv {
-            for i in 0..=nu {
-                let (u, v) = (i as f64 / nu as f64, j as f64 / nv as f64);
-                let d = face.derivs(u, v);
-                let n = DiffGeom::try_from_derivs(&d)
-                    .map(|g| g.normal)
-                    .or_else(|| {
-                        // At a singular point take the normal a little inside the face.
-                        let (uu, vv) = (0.5 + (u - 0.5) * 0.999, 0.5 + (v - 0.5) * 0.999);
-                        DiffGeom::try_from_derivs(&face.derivs(uu, vv)).map(|g| g.normal)
-                    })
-                    .unwrap_or_else(crate::geom::Vector3::z);
-                t.positions
-                    .extend([d.point.x as f32, d.point.y as f32, d.point.z as f32]);
-                t.normals.extend([n.x as f32, n.y as f32, n.z as f32]);
+        let f = &mesh.faces()[h.face as usize];
+        let len = if h.side % 2 == 0 { f.width } else { f.height };
+        let (a, b) = (h.offset / len, (h.offset + h.knot) / len);
+        let face = &faces[d];
+        let curve = |t: f64| {
+            let s = a + (b - a) * t;
+            let (u, v) = on_side(h.side, s);
+            let dd = face.derivs(u, v);
+            let (d1, d2) = if h.side % 2 == 0 {
+                (dd.su, dd.suu)
+            } else {
+                (dd.sv, dd.svv)
+            };
+            (dd.point, d1 * (b - a), d2 * ((b - a) * (b - a)))
+        };
+        let mut n = segments(&curve, chordal_mm);
+        for half in std::iter::once(h).chain(h.twin.map(|t| mesh.he(t))) {
+            if let Some(&df) = domain.get(&half.face) {
+                let mf = &mesh.faces()[half.face as usize];
+                let (cells, len) = if half.side % 2 == 0 {
+                    (grid[df].0, mf.width)
+                } else {
+                    (grid[df].1, mf.height)
+                };
+                n = n.max((cells as f64 * half.knot / len).ceil() as usize);
             }
         }
-        let id = |i: usize, j: usize| base + (j * (nu + 1) + i) as u32;
-        for j in 0..nv {
-            for i in 0..nu {
-                t.indices.extend([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                t.indices.extend([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-                t.patch_ids.extend([fi as u32, fi as u32]);
-            }
+        let key = edge_key(h.origin, mesh.he(h.next).origin);
+        edge_segments.insert(key, n.min(MAX_SEGMENTS));
+    }
+    // Patch of each face region: the pieces of the layout.
+    let mut pieces: Vec<Vec<(u32, [f64; 4])>> = vec![Vec::new(); faces.len()];
+    for (pi, p) in layout.patches.iter().enumerate() {
+        for piece in &p.pieces {
+            pieces[piece.face as usize].push((pi as u32, piece.local));
         }
     }
+    let mut t = Tessellation::default();
+    let mut shared: HashMap<(u32, u32, usize), u32> = HashMap::new();
+    let mut corner: HashMap<u32, u32> = HashMap::new();
+    for (d, face) in faces.iter().enumerate() {
+        let mf = face.mesh_face;
+        // Boundary loop: (u, v) and shared-vertex key.
+        let mut outer: Vec<(f64, f64, Option<VKey>)> = Vec::new();
+        let mut outer_tau: Vec<f64> = Vec::new();
+        for h in mesh.face_half_edges(mf) {
+            let e = mesh.he(h);
+            if e.knot == 0.0 {
+                continue;
+            }
+            let (a, b) = (e.origin, mesh.he(e.next).origin);
+            let len = if e.side % 2 == 0 {
+                face.width
+            } else {
+                face.height
+            };
+            let n = edge_segments[&edge_key(a, b)];
+            for k in 0..n {
+                let s = (e.offset + e.knot * k as f64 / n as f64) / len;
+                let (u, v) = on_side(e.side, s);
+                let key = if k == 0 {
+                    VKey::Vertex(root(&mut rep, a))
+                } else {
+                    // Edge samples are numbered from the edge's lower vertex id.
+                    VKey::Edge(a.min(b), a.max(b), if a < b { k } else { n - k })
+                };
+                outer.push((u, v, Some(key)));
+                outer_tau.push(e.side as f64 + s);
+            }
+        }
+        // Inner grid, with lines at the face's patch-piece borders.
+        let (nu, nv_) = grid[d];
+        let mut us: Vec<f64> = (0..=nu).map(|i| i as f64 / nu as f64).collect();
+        let mut vs: Vec<f64> = (0..=nv_).map(|j| j as f64 / nv_ as f64).collect();
+        for &(_, r) in &pieces[d] {
+            us.extend([r[0] / face.width, r[1] / face.width]);
+            vs.extend([r[2] / face.height, r[3] / face.height]);
+        }
+        for g in [&mut us, &mut vs] {
+            g.sort_by(f64::total_cmp);
+            g.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        }
+        let (gu, gv) = (us.len() - 1, vs.len() - 1);
+        let mut add = |u: f64, v: f64, key: Option<VKey>, t: &mut Tessellation| -> u32 {
+            let lookup = match key {
+                Some(VKey::Vertex(v)) => corner.get(&v).copied(),
+                Some(VKey::Edge(a, b, k)) => shared.get(&(a, b, k)).copied(),
+                None => None,
+            };
+            if let Some(i) = lookup {
+                return i;
+            }
+            let p = face.subs(u, v);
+            let n = face.normal(u, v).unwrap_or_else(Vector3::z);
+            let idx = (t.positions.len() / 3) as u32;
+            t.positions.extend([p.x as f32, p.y as f32, p.z as f32]);
+            t.normals.extend([n.x as f32, n.y as f32, n.z as f32]);
+            t.params.push((d as u32, u, v));
+            match key {
+                Some(VKey::Vertex(v)) => {
+                    corner.insert(v, idx);
+                }
+                Some(VKey::Edge(a, b, k)) => {
+                    shared.insert((a, b, k), idx);
+                }
+                None => {}
+            }
+            idx
+        };
+        let outer_idx: Vec<u32> = outer
+            .iter()
+            .map(|&(u, v, k)| add(u, v, k, &mut t))
+            .collect();
+        let outer_uv: Vec<(f64, f64)> = outer.iter().map(|&(u, v, _)| (u, v)).collect();
+        // Inner lattice (i, j) in 1..gu × 1..gv.
+        let mut inner = vec![0u32; (gu + 1) * (gv + 1)];
+        for j in 1..gv {
+            for i in 1..gu {
+                inner[j * (gu + 1) + i] = add(us[i], vs[j], None, &mut t);
+            }
+        }
+        let patch_at = |u: f64, v: f64| -> u32 {
+            let (x, y) = (u * face.width, v * face.height);
+            pieces[d]
+                .iter()
+                .find(|(_, r)| x >= r[0] && x <= r[1] && y >= r[2] && y <= r[3])
+                .map(|p| p.0)
+                .unwrap_or(0)
+        };
+        let tri = |a: u32, b: u32, c: u32, uv: [(f64, f64); 3], t: &mut Tessellation| {
+            if a == b || b == c || a == c {
+                return;
+            }
+            t.indices.extend([a, b, c]);
+            let cu = (uv[0].0 + uv[1].0 + uv[2].0) / 3.0;
+            let cv = (uv[0].1 + uv[1].1 + uv[2].1) / 3.0;
+            t.patch_ids.push(patch_at(cu, cv));
+        };
+        for j in 1..gv.saturating_sub(1) {
+            for i in 1..gu.saturating_sub(1) {
+                let id = |i: usize, j: usize| inner[j * (gu + 1) + i];
+                let uv = |i: usize, j: usize| (us[i], vs[j]);
+                tri(
+                    id(i, j),
+                    id(i + 1, j),
+                    id(i + 1, j + 1),
+                    [uv(i, j), uv(i + 1, j), uv(i + 1, j + 1)],
+                    &mut t,
+                );
+                tri(
+                    id(i, j),
+                    id(i + 1, j + 1),
+                    id(i, j + 1),
+                    [uv(i, j), uv(i + 1, j + 1), uv(i, j + 1)],
+                    &mut t,
+                );
+            }
+        }
+        // Inner ring, counter-clockwise from its lower-left corner (the grid has at least
+        // three cells each way, so the ring is a proper rectangle), with its position around
+        // the face measured like the boundary's: side number plus the coordinate along it.
+        let mut ring: Vec<(usize, usize, f64)> = Vec::new();
+        ring.extend((1..gu).map(|i| (i, 1, us[i])));
+        ring.extend((2..gv).map(|j| (gu - 1, j, 1.0 + vs[j])));
+        ring.extend((1..gu - 1).rev().map(|i| (i, gv - 1, 3.0 - us[i])));
+        ring.extend((2..gv - 1).rev().map(|j| (1, j, 4.0 - vs[j])));
+        let ring_idx: Vec<u32> = ring
+            .iter()
+            .map(|&(i, j, _)| inner[j * (gu + 1) + i])
+            .collect();
+        let ring_uv: Vec<(f64, f64)> = ring.iter().map(|&(i, j, _)| (us[i], vs[j])).collect();
+        let ring_tau: Vec<f64> = ring.iter().map(|r| r.2).collect();
+        let centre = face.derivs(0.5, 0.5);
+        let (su, sv) = (centre.su.norm(), centre.sv.norm());
+        let metric = |a: (f64, f64), b: (f64, f64)| ((a.0 - b.0) * su).hypot((a.1 - b.1) * sv);
+        zip(
+            (&outer_idx, &outer_uv, &outer_tau),
+            (&ring_idx, &ring_uv, &ring_tau),
+            &metric,
+            &mut |a, b, c, uv| tri(a, b, c, uv, &mut t),
+        );
+    }
     t
+}
+
+/// Key of a vertex shared between faces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum VKey {
+    Vertex(u32),
+    Edge(u32, u32, usize),
+}
+
+fn edge_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// `(u, v)` at fraction `s` along side `side` of a face.
+fn on_side(side: u8, s: f64) -> (f64, f64) {
+    match side {
+        0 => (s, 0.0),
+        1 => (1.0, s),
+        2 => (1.0 - s, 1.0),
+        _ => (0.0, 1.0 - s),
+    }
+}
+
+/// How far (in sides of the rectangles) one loop may run ahead of the other before the
+/// zipper must advance the one behind, whatever the edge lengths say.
+const STEP_SLACK: f64 = 1e-9;
+
+/// Triangulates the band between a closed outer loop and a closed inner loop, both
+/// counter-clockwise, by walking both in step around the square.
+/// A closed loop: vertex ids, parameters, and positions around its rectangle (0..4,
+/// increasing, starting at the lower-left corner).
+type Loop<'a> = (&'a [u32], &'a [(f64, f64)], &'a [f64]);
+
+fn zip(
+    outer: Loop,
+    inner: Loop,
+    metric: &dyn Fn((f64, f64), (f64, f64)) -> f64,
+    tri: &mut dyn FnMut(u32, u32, u32, [(f64, f64); 3]),
+) {
+    let (oi, ouv, ot) = outer;
+    let (ii, iuv, it) = inner;
+    let (no, ni) = (oi.len(), ii.len());
+    if no == 0 || ni == 0 {
+        return;
+    }
+    let pos = |t: &[f64], k: usize| if k >= t.len() { 4.0 } else { t[k] };
+    let (mut i, mut j) = (0usize, 0usize);
+    while i < no || j < ni {
+        let (o0, n0) = (i % no, j % ni);
+        let (o1, n1) = ((i + 1) % no, (j + 1) % ni);
+        let advance_outer = if i == no {
+            false
+        } else if j == ni {
+            true
+        } else {
+            // Both loops stay roughly in step around their rectangles; between the two
+            // possible triangles take the one with the shorter new edge.
+            let (to, ti) = (pos(ot, i + 1), pos(it, j + 1));
+            if (to - ti).abs() > STEP_SLACK {
+                to < ti
+            } else {
+                metric(ouv[o1], iuv[n0]) <= metric(ouv[o0], iuv[n1])
+            }
+        };
+        if advance_outer {
+            tri(oi[o0], oi[o1], ii[n0], [ouv[o0], ouv[o1], iuv[n0]]);
+            i += 1;
+        } else {
+            tri(oi[o0], ii[n1], ii[n0], [ouv[o0], iuv[n1], iuv[n0]]);
+            j += 1;
+        }
+    }
 }

@@ -11,7 +11,14 @@
 //! Opposite sides have equal sums of knot intervals, giving the face a parametric width
 //! (side 0) and height (side 1). A face of zero width or height is a *degenerate* face: it
 //! carries repeated knots (e.g. Bézier end conditions) but no piece of surface.
+//!
+//! A degenerate face may have one empty side (side 1 or 2: two corners at the same loop
+//! position, a zero-length side with no edge). Such a face is a zero-area triangle with a
+//! *cusp*, where its two long sides leave one vertex in the same direction: this is how a
+//! stack of repeated knot lines ends, fanning into one vertex (e.g. the repeated knots of a
+//! concave boundary corner with Bézier end conditions). It occupies no angle at the cusp.
 
+pub mod refine;
 pub mod walk;
 
 use crate::error::{Error, Result};
@@ -47,7 +54,8 @@ impl ControlPoint {
 }
 
 /// One face as given by a reader: its vertex loop (counter-clockwise) and which loop
-/// positions are its four corners, starting with the corner where side 0 begins.
+/// positions are its four corners, starting with the corner where side 0 begins. Corners 1
+/// and 2, or 2 and 3, may share a loop position on a zero-area face (an empty side).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FaceLoop {
     pub vertices: Vec<u32>,
@@ -154,24 +162,25 @@ impl TMesh {
                     "face {fi} has {n} vertices; at least 4 needed"
                 )));
             }
-            let mut c = fl.corners;
+            let c = fl.corners;
             if c.iter().any(|&k| k as usize >= n) {
                 return Err(Error::InvalidMesh(format!(
                     "face {fi}: a corner index is beyond its {n} vertices"
                 )));
             }
-            // Corners must appear in loop order starting at corners[0].
+            // Corners must appear in loop order starting at corners[0]; at most one of sides
+            // 1 and 2 may be empty (two corners at one position).
             let rel: Vec<usize> = c
                 .iter()
                 .map(|&k| (k as usize + n - c[0] as usize) % n)
                 .collect();
-            if !(rel[0] < rel[1] && rel[1] < rel[2] && rel[2] < rel[3]) {
+            let empty_sides = usize::from(rel[1] == rel[2]) + usize::from(rel[2] == rel[3]);
+            if !(rel[0] < rel[1] && rel[1] <= rel[2] && rel[2] <= rel[3] && empty_sides <= 1) {
                 return Err(Error::InvalidMesh(format!(
-                    "face {fi}: corners {:?} are not four distinct loop positions in order",
+                    "face {fi}: corners {:?} are not loop positions in order (only side 1 or side 2 may be empty)",
                     fl.corners
                 )));
             }
-            c.sort_unstable();
             let base = half_edges.len() as u32;
             let start = fl.corners[0] as usize;
             let mut side = 0u8;
@@ -179,9 +188,12 @@ impl TMesh {
             let mut sums = [0.0f64; 4];
             for k in 0..n {
                 let li = (start + k) % n;
-                if k > 0 && fl.corners.contains(&(li as u32)) {
-                    side += 1;
-                    offset = 0.0;
+                if k > 0 {
+                    let corners_here = c.iter().filter(|&&p| p as usize == li).count();
+                    if corners_here > 0 {
+                        side += corners_here as u8;
+                        offset = 0.0;
+                    }
                 }
                 let a = fl.vertices[li];
                 let b = fl.vertices[(li + 1) % n];
@@ -344,14 +356,15 @@ impl TMesh {
     }
 
     /// Angle (in quarter turns) the face of half-edge `h` occupies at `h`'s origin: 1 at a
-    /// corner of the face, 2 where the origin is a T-junction on one of its sides.
+    /// corner of the face, 2 where the origin is a T-junction on one of its sides, 0 at the
+    /// cusp of a face with an empty side.
     #[inline]
     pub fn sector_quarters(&self, h: u32) -> u32 {
         let e = self.he(h);
-        if self.he(e.prev).side == e.side {
-            2
-        } else {
-            1
+        match (e.side + 4 - self.he(e.prev).side) % 4 {
+            0 => 2,
+            1 => 1,
+            _ => 0,
         }
     }
 
@@ -470,9 +483,11 @@ impl TMesh {
                 let hs = self.face_half_edges(f);
                 let vertices: Vec<u32> = hs.iter().map(|&h| self.he(h).origin).collect();
                 let mut corners = [0u32; 4];
-                let mut k = 0;
-                for (i, &h) in hs.iter().enumerate() {
-                    if i == 0 || self.he(self.he(h).prev).side != self.he(h).side {
+                let mut k = 1;
+                for (i, &h) in hs.iter().enumerate().skip(1) {
+                    // A side step of two is an empty side: two corners at one position.
+                    let step = (self.he(h).side + 4 - self.he(self.he(h).prev).side) % 4;
+                    for _ in 0..step {
                         if k < 4 {
                             corners[k] = i as u32;
                         }

@@ -138,14 +138,23 @@ impl TMesh {
                 break;
             }
         }
-        // Falls on the side's far corner only through rounding: take the last vertex.
+        // Falls on the side's far corner only through rounding: take the last vertex. An
+        // empty opposite side (a zero-area face's cusp) lands on the cusp, the origin of the
+        // next side, whose direction is a quarter turn further: the ray is two quarters on.
         let landing = landing.unwrap_or_else(|| {
-            let h = self
-                .face_half_edges(f)
-                .into_iter()
-                .rfind(|&h| self.he(h).side == opp)
-                .expect("every face has four sides");
-            At::Vertex { h_ref: h, theta: 3 }
+            let hs = self.face_half_edges(f);
+            match hs.iter().rfind(|&&h| self.he(h).side == opp) {
+                Some(&h) => At::Vertex { h_ref: h, theta: 3 },
+                None => {
+                    let next = (opp + 1) % 4;
+                    let h = hs
+                        .iter()
+                        .copied()
+                        .find(|&h| self.he(h).side == next)
+                        .unwrap_or(hs[0]);
+                    At::Vertex { h_ref: h, theta: 2 }
+                }
+            }
         });
         (across, landing)
     }
@@ -233,7 +242,7 @@ impl TMesh {
     }
 
     /// Local origin and direction (quarter turns) of half-edge `h` in its face's frame.
-    fn local_frame(&self, h: u32) -> ([f64; 2], u8) {
+    pub(crate) fn local_frame(&self, h: u32) -> ([f64; 2], u8) {
         let e = self.he(h);
         let f = &self.faces[e.face as usize];
         let o = e.offset;
@@ -354,7 +363,7 @@ impl TMesh {
 
 /// Rotation by `k` quarter turns counter-clockwise.
 #[inline]
-fn rot(k: u8, p: [f64; 2]) -> [f64; 2] {
+pub(crate) fn rot(k: u8, p: [f64; 2]) -> [f64; 2] {
     match k % 4 {
         0 => p,
         1 => [-p[1], p[0]],
@@ -365,7 +374,7 @@ fn rot(k: u8, p: [f64; 2]) -> [f64; 2] {
 
 /// Unit vector of quarter-turn direction `k`.
 #[inline]
-fn unit(k: u8) -> [f64; 2] {
+pub(crate) fn unit(k: u8) -> [f64; 2] {
     rot(k, [1.0, 0.0])
 }
 
@@ -377,4 +386,74 @@ fn shift(k: &LocalKnots, d: f64) -> LocalKnots {
 /// Knots of `x ↦ N(c − x)`: `c − k`, reversed.
 fn mirror(k: &LocalKnots, c: f64) -> LocalKnots {
     [c - k[4], c - k[3], c - k[2], c - k[1], c - k[0]]
+}
+
+/// One step of a knot line traced through the mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LineStep {
+    /// Along an edge (given by one of its half-edges).
+    Edge(u32),
+    /// Across face `face`, perpendicular to its side `side`, entering at distance `pos`
+    /// (knot units) from that side's first corner.
+    Cross { face: u32, side: u8, pos: f64 },
+}
+
+impl TMesh {
+    /// Traces the straight knot line that leaves vertex `origin(h)` along half-edge `h`:
+    /// through vertices (straight on), across faces where it meets a T-junction's stem,
+    /// until `stop` returns true at a vertex it reaches, or it leaves the mesh.
+    pub fn trace_line(&self, h: u32, stop: &mut dyn FnMut(u32) -> bool) -> Vec<LineStep> {
+        let mut steps = vec![LineStep::Edge(h)];
+        let limit = self.half_edges.len() + self.faces.len() + 4;
+        let n = self.he(h).next;
+        let mut state = At::Vertex {
+            h_ref: n,
+            theta: self.sector_quarters(n) + 2,
+        };
+        for _ in 0..limit {
+            match state {
+                At::Vertex { h_ref, theta } => {
+                    if stop(self.he(h_ref).origin) {
+                        break;
+                    }
+                    match self.look(h_ref, theta) {
+                        Look::Edge(e) => {
+                            steps.push(LineStep::Edge(e));
+                            let n = self.he(e).next;
+                            state = At::Vertex {
+                                h_ref: n,
+                                theta: self.sector_quarters(n) + 2,
+                            };
+                        }
+                        Look::EdgeBack(p) => {
+                            steps.push(LineStep::Edge(p));
+                            state = At::Vertex { h_ref: p, theta: 2 };
+                        }
+                        Look::Face(f) => {
+                            let e = self.he(f);
+                            steps.push(LineStep::Cross {
+                                face: e.face,
+                                side: e.side,
+                                pos: e.offset,
+                            });
+                            state = self.cross(e.face, e.side, e.offset).1;
+                        }
+                        Look::Boundary => break,
+                    }
+                }
+                At::Side { h, pos } => {
+                    let Some(t) = self.he(h).twin else { break };
+                    let e = self.he(t);
+                    let at = e.offset + self.he(h).knot - pos;
+                    steps.push(LineStep::Cross {
+                        face: e.face,
+                        side: e.side,
+                        pos: at,
+                    });
+                    state = self.cross(e.face, e.side, at).1;
+                }
+            }
+        }
+        steps
+    }
 }

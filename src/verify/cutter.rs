@@ -31,11 +31,15 @@ pub struct ToolTip {
     pub line: usize,
 }
 
-/// A ball-end tool's path: radius and centre positions in order.
+/// A ball-end tool's path: radius and centre positions in order, joined by straight moves
+/// except where the path is broken.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CutterPath {
     pub tool_radius_mm: f64,
     pub locations: Vec<CutterLocation>,
+    /// Indices `i` of locations not reached by a straight move from location `i − 1` (the
+    /// tool moved in a way the path does not know, e.g. in machine coordinates).
+    pub breaks: Vec<usize>,
 }
 
 /// Largest deviation of a tool axis from unit length that is accepted (and normalised).
@@ -83,6 +87,7 @@ impl CutterPath {
         Ok(CutterPath {
             tool_radius_mm,
             locations: out,
+            breaks: Vec::new(),
         })
     }
 
@@ -106,7 +111,30 @@ impl CutterPath {
         tool_radius_mm: f64,
         tips: impl IntoIterator<Item = ToolTip>,
     ) -> Result<Self> {
-        let tips: Vec<ToolTip> = tips.into_iter().collect();
+        Self::from_tool_poses(tool_radius_mm, tips.into_iter().map(Some))
+    }
+
+    /// Ball centres from tool tips, where `None` (a position the reader could not place in
+    /// the workpiece frame) breaks the path: no straight move is assumed across it.
+    pub fn from_tool_poses(
+        tool_radius_mm: f64,
+        poses: impl IntoIterator<Item = Option<ToolTip>>,
+    ) -> Result<Self> {
+        let mut tips: Vec<ToolTip> = Vec::new();
+        let mut breaks: Vec<usize> = Vec::new();
+        let mut broken = false;
+        for p in poses {
+            match p {
+                Some(t) => {
+                    if broken && !tips.is_empty() {
+                        breaks.push(tips.len());
+                    }
+                    broken = false;
+                    tips.push(t);
+                }
+                None => broken = true,
+            }
+        }
         for t in &tips {
             let len = t.tool_axis.norm();
             if !((len - 1.0).abs() <= AXIS_LENGTH_TOLERANCE) {
@@ -119,7 +147,7 @@ impl CutterPath {
                 ));
             }
         }
-        Self::try_new(
+        let mut path = Self::try_new(
             tool_radius_mm,
             tips.iter()
                 .map(|t| {
@@ -130,22 +158,26 @@ impl CutterPath {
                     }
                 })
                 .collect(),
-        )
+        )?;
+        path.breaks = breaks;
+        Ok(path)
     }
 
-    /// The swept volume of every straight move (a single ball if there is one position).
+    /// The swept volume of every straight move, and a ball at every position that no move
+    /// reaches or leaves (a lone position between breaks).
     pub fn capsules(&self) -> Vec<Capsule> {
-        match self.locations.len() {
-            1 => vec![Capsule::new(
-                self.locations[0].cl_point,
-                self.locations[0].cl_point,
-            )],
-            _ => self
-                .locations
-                .windows(2)
-                .map(|w| Capsule::new(w[0].cl_point, w[1].cl_point))
-                .collect(),
+        let n = self.locations.len();
+        let joined = |i: usize| i > 0 && i < n && !self.breaks.contains(&i);
+        let mut out = Vec::with_capacity(n);
+        for i in 0..n {
+            let p = self.locations[i].cl_point;
+            if joined(i + 1) {
+                out.push(Capsule::new(p, self.locations[i + 1].cl_point));
+            } else if !joined(i) {
+                out.push(Capsule::new(p, p));
+            }
         }
+        out
     }
 
     /// Reads the JSON CL-data format:
@@ -224,5 +256,45 @@ impl CutterPath {
             });
         }
         Self::try_new(tool_radius_mm, locations)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn breaks_leave_no_move_across_them() {
+        let tip = |x: f64, line| {
+            Some(ToolTip {
+                tip: Point3::new(x, 0.0, 0.0),
+                tool_axis: Vector3::z(),
+                line,
+            })
+        };
+        // a–b joined, break, lone c, break, d–e joined.
+        let p = CutterPath::from_tool_poses(
+            0.5,
+            [
+                tip(0.0, 1),
+                tip(1.0, 2),
+                None,
+                tip(2.0, 4),
+                None,
+                None,
+                tip(3.0, 7),
+                tip(4.0, 8),
+            ],
+        )
+        .unwrap();
+        assert_eq!(p.breaks, vec![2, 3]);
+        assert_eq!(p.locations[0].cl_point, Point3::new(0.0, 0.0, 0.5));
+        let caps: Vec<(f64, f64)> = p
+            .capsules()
+            .iter()
+            .map(|c| (c.start.x, c.end().x))
+            .collect();
+        assert_eq!(caps, vec![(0.0, 1.0), (2.0, 2.0), (3.0, 4.0)]);
+        assert!(CutterPath::from_tool_poses(0.5, [None, None]).is_err());
     }
 }

@@ -9,7 +9,7 @@ use super::index::CapsuleIndex;
 use super::probe::{Material, Probe};
 use super::stats::weighted_quantile;
 use super::{CutterPath, PatchVerification, ToolSide, Verification, VerifyOptions};
-use crate::geom::{Aabb, Point3};
+use crate::geom::{Aabb, Point3, Vector3};
 use crate::surface::{DiffGeom, FaceSurface, Surface, SurfaceDerivs};
 
 /// Samples per side used to estimate a patch's area and side lengths.
@@ -44,6 +44,8 @@ struct FaceGrid {
 #[derive(Debug, Clone, Copy)]
 struct Sample {
     corner: Corner,
+    /// Unit normal `S_u × S_v` (zero where there is none).
+    normal: Vector3,
     singular: bool,
     /// `|S_u × S_v|` (mm² per unit parameter²).
     area_density: f64,
@@ -195,6 +197,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, face: &FaceSurface, u: f64, v: f64) -> 
             metric: [0.0; 3],
             second: [0.0; 3],
         },
+        normal: Vector3::zeros(),
         singular,
         area_density,
     };
@@ -242,6 +245,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, face: &FaceSurface, u: f64, v: f64) -> 
             metric: [g.e, g.f, g.g],
             second: [d.suu.norm(), d.suv.norm(), d.svv.norm()],
         },
+        normal: g.normal,
         singular: false,
         area_density,
     }
@@ -299,7 +303,7 @@ fn band(
                 acc.samples += 1;
                 acc.area += w;
                 if let Some(h) = heat.as_deref_mut() {
-                    h.add(fi as u32, &s.corner.point, heat_value(s, tol));
+                    h.add(&s.corner.point, &s.normal, heat_value(s, tol));
                 }
                 if s.singular {
                     acc.singular += 1;

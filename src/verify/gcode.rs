@@ -1,40 +1,28 @@
-//! Reads the three-axis G-code `tspath plan` writes (`machine::gcode_3axis`: tool-tip
-//! `X Y Z`, tool axis +Z) back into tool tips, for [`CutterPath::from_tool_tips`].
+//! Programs as the verifier reads them: the machine module's reader and kinematics turn any
+//! dialect the project writes (and common hand-written G-code) into tool tips and axes, and
+//! this adapter hands those to [`CutterPath::from_tool_poses`]. Blocks in machine
+//! coordinates (a `G53` retract, say) have no workpiece pose: the path is broken there.
 //!
-//! This is a small adapter, not a general interpreter: `G0`/`G1` moves in `G90`/`G91`,
-//! `G20`/`G21`, comments in parentheses or after `;`, and the modal words the writer emits.
-//! Anything that changes the geometry in ways it does not model (arcs, rotary axes, work
-//! offsets, tool-length changes mid-program) is an error naming the line. Five-axis
-//! programs come in through a dialect reader's tool tips and axes instead.
+//! The header comment `tool: ... ball-end radius R mm, scallop H mm, chordal C mm` that the
+//! post writes is read too, for the tolerances the program was made for.
 //!
-//! [`CutterPath::from_tool_tips`]: super::CutterPath::from_tool_tips
+//! [`CutterPath::from_tool_poses`]: super::CutterPath::from_tool_poses
 
-use super::cutter::ToolTip;
+use super::cutter::{CutterPath, ToolTip};
+use super::VerifyOptions;
 use crate::error::{Error, Result};
-use crate::geom::{Point3, Vector3};
+use crate::machine::{reader, roundtrip, Dialect, Machine};
 
-/// What the program says, besides its moves.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GcodeProgram {
-    /// Tool tips in program order, in mm, axis +Z.
-    pub tips: Vec<ToolTip>,
-    /// Ball radius from a `(tool: ball-end radius R mm, ...)` header comment, if present.
-    pub header_tool_radius_mm: Option<f64>,
-    /// Scallop height from the same header comment, if present.
-    pub header_scallop_mm: Option<f64>,
-    /// Chordal tolerance from the same header comment, if present.
-    pub header_chordal_mm: Option<f64>,
+/// What a program's header says about the tool and the tolerances.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ProgramHeader {
+    /// Ball radius (mm), if stated.
+    pub tool_radius_mm: Option<f64>,
+    /// Scallop height asked of the planner (mm), if stated.
+    pub scallop_mm: Option<f64>,
+    /// Chordal tolerance of the planner (mm), if stated.
+    pub chordal_mm: Option<f64>,
 }
-
-/// Millimetres per inch.
-const MM_PER_INCH: f64 = 25.4;
-
-/// G codes that change nothing this reader models (plane, units handled separately, cutter
-/// compensation off, tool length offset as programmed, canned cycles off, feed mode, exact
-/// path, work coordinate systems G54–G59 taken as the model frame).
-const HARMLESS_G: &[u32] = &[
-    170, 180, 190, 400, 430, 490, 800, 940, 540, 550, 560, 570, 580, 590, 610, 640,
-];
 
 fn number_after(text: &str, key: &str) -> Option<f64> {
     let at = text.find(key)? + key.len();
@@ -45,218 +33,135 @@ fn number_after(text: &str, key: &str) -> Option<f64> {
     rest[..end].parse().ok()
 }
 
-/// Parses a program; errors name the line and the word.
-pub fn read_3axis(text: &str) -> Result<GcodeProgram> {
-    let err = |line: usize, msg: String| Error::parse("G-code", format!("line {line}"), msg);
-    let mut prog = GcodeProgram {
-        tips: Vec::new(),
-        header_tool_radius_mm: None,
-        header_scallop_mm: None,
-        header_chordal_mm: None,
-    };
-    let mut pos: [Option<f64>; 3] = [None; 3];
-    let mut motion: Option<u32> = None;
-    let mut scale = 1.0;
-    let mut absolute = true;
-    for (idx, raw) in text.lines().enumerate() {
-        let line_no = idx + 1;
-        // Comments: (...) and ; to the end of the line. Header comments carry the tool.
-        let mut code = String::with_capacity(raw.len());
-        let mut rest = raw;
-        while let Some(open) = rest.find(['(', ';']) {
-            code.push_str(&rest[..open]);
-            if rest[open..].starts_with(';') {
-                rest = "";
-                break;
-            }
-            let Some(close) = rest[open..].find(')') else {
-                return Err(err(
-                    line_no,
-                    "comment `(` is not closed on this line".into(),
-                ));
-            };
-            let comment = &rest[open + 1..open + close];
-            if comment.trim_start().starts_with("tool:") {
-                prog.header_tool_radius_mm = number_after(comment, "radius");
-                prog.header_scallop_mm = number_after(comment, "scallop");
-                prog.header_chordal_mm = number_after(comment, "chordal");
-            }
-            rest = &rest[open + close + 1..];
-        }
-        code.push_str(rest);
-        let code = code.trim();
-        if code.is_empty() || code == "%" {
-            continue;
-        }
-        // Words: a letter and a number.
-        let mut words: Vec<(char, f64, &str)> = Vec::new();
-        let bytes = code.as_bytes();
-        let mut i = 0;
-        while i < bytes.len() {
-            let c = bytes[i] as char;
-            if c.is_ascii_whitespace() {
-                i += 1;
-                continue;
-            }
-            if !c.is_ascii_alphabetic() {
-                return Err(err(line_no, format!("expected a word letter, found `{c}`")));
-            }
-            let start = i + 1;
-            let mut j = start;
-            while j < bytes.len() && {
-                let d = bytes[j] as char;
-                d.is_ascii_digit() || d == '.' || d == '-' || d == '+' || d == ' '
-            } {
-                j += 1;
-            }
-            let num_text: String = code[start..j].chars().filter(|c| *c != ' ').collect();
-            let value: f64 = num_text.parse().map_err(|_| {
-                err(
-                    line_no,
-                    format!(
-                        "word `{c}` needs a number, found `{}`",
-                        code[start..j].trim()
-                    ),
-                )
-            })?;
-            if !value.is_finite() {
-                return Err(err(line_no, format!("word `{c}` has a non-finite value")));
-            }
-            words.push((c.to_ascii_uppercase(), value, &code[i..j]));
-            i = j;
-        }
-        let mut coords: [Option<f64>; 3] = [None; 3];
-        let mut end = false;
-        for &(letter, value, text) in &words {
-            match letter {
-                'G' => {
-                    let g = (value * 10.0).round() as u32;
-                    match g {
-                        0 | 10 => motion = Some(g / 10),
-                        20 | 30 => {
-                            return Err(err(
-                                line_no,
-                                format!("`{}`: arcs are not supported by this reader", text.trim()),
-                            ))
-                        }
-                        200 => scale = MM_PER_INCH,
-                        210 => scale = 1.0,
-                        900 => absolute = true,
-                        910 => absolute = false,
-                        g if HARMLESS_G.contains(&g) => {}
-                        _ => {
-                            return Err(err(
-                                line_no,
-                                format!("`{}` is not supported by the three-axis reader", text.trim()),
-                            ))
-                        }
-                    }
-                }
-                'X' => coords[0] = Some(value),
-                'Y' => coords[1] = Some(value),
-                'Z' => coords[2] = Some(value),
-                'A' | 'B' | 'C' => {
-                    return Err(err(
-                        line_no,
-                        format!(
-                            "rotary axis word `{}`: this reader takes three-axis programs (tool axis +Z); read five-axis programs with a dialect reader and pass its tool tips",
-                            text.trim()
-                        ),
-                    ))
-                }
-                'M' => {
-                    if matches!(value as u32, 2 | 30) && value.fract() == 0.0 {
-                        end = true;
-                    }
-                }
-                'F' | 'S' | 'T' | 'H' | 'N' | 'D' => {}
-                other => {
-                    return Err(err(
-                        line_no,
-                        format!("word `{other}` is not supported by the three-axis reader"),
-                    ))
-                }
-            }
-        }
-        if coords.iter().any(|c| c.is_some()) {
-            if motion.is_none() {
-                return Err(err(
-                    line_no,
-                    "coordinates before any G0 or G1 motion mode".into(),
-                ));
-            }
-            for k in 0..3 {
-                if let Some(c) = coords[k] {
-                    let c = c * scale;
-                    pos[k] = Some(if absolute {
-                        c
-                    } else {
-                        pos[k].unwrap_or(0.0) + c
-                    });
-                }
-            }
-            if let [Some(x), Some(y), Some(z)] = pos {
-                prog.tips.push(ToolTip {
-                    tip: Point3::new(x, y, z),
-                    tool_axis: Vector3::z(),
-                    line: line_no,
-                });
-            }
-        }
-        if end {
-            break;
-        }
+impl ProgramHeader {
+    /// The first line mentioning a `ball-end radius` (in a comment of any dialect).
+    pub fn parse(text: &str) -> Self {
+        text.lines()
+            .find(|l| l.contains("ball-end radius"))
+            .map(|l| ProgramHeader {
+                tool_radius_mm: number_after(l, "ball-end radius"),
+                scallop_mm: number_after(l, "scallop"),
+                chordal_mm: number_after(l, "chordal"),
+            })
+            .unwrap_or_default()
     }
-    if prog.tips.is_empty() {
-        return Err(err(
-            text.lines().count(),
-            "the program has no move with all of X, Y and Z known".into(),
+}
+
+/// The tool tip and axis of every motion block of `text` on `machine` as `dialect` means it;
+/// `None` for blocks without a workpiece pose. Errors name the line the reader stopped at.
+pub fn read_tool_poses(
+    text: &str,
+    machine: &Machine,
+    dialect: Dialect,
+) -> Result<Vec<Option<ToolTip>>> {
+    let program = reader::read(text)?;
+    let poses = roundtrip::tool_poses(&program, machine, dialect);
+    let out: Vec<Option<ToolTip>> = program
+        .moves
+        .iter()
+        .zip(poses)
+        .map(|(m, pose)| {
+            pose.map(|p| ToolTip {
+                tip: p.tip,
+                tool_axis: p.axis,
+                line: m.line,
+            })
+        })
+        .collect();
+    if out.iter().all(|p| p.is_none()) {
+        return Err(Error::parse(
+            "G-code",
+            format!("line {}", text.lines().count()),
+            "the program has no move with a known tool position in the workpiece frame",
         ));
     }
-    Ok(prog)
+    Ok(out)
+}
+
+/// A program as a cutter path for a ball of radius `tool_radius_mm`, and its header. Errors
+/// if the header states another radius (the program was made for another tool).
+pub fn read_program(
+    text: &str,
+    tool_radius_mm: f64,
+    machine: &Machine,
+    dialect: Dialect,
+) -> Result<(CutterPath, ProgramHeader)> {
+    let header = ProgramHeader::parse(text);
+    if let Some(hr) = header.tool_radius_mm {
+        if hr != tool_radius_mm {
+            return Err(Error::param(
+                "tool_radius_mm",
+                format!(
+                    "the program says it was made for a ball-end radius {hr} mm, but the tool radius given is {tool_radius_mm} mm"
+                ),
+            ));
+        }
+    }
+    let poses = read_tool_poses(text, machine, dialect)?;
+    Ok((CutterPath::from_tool_poses(tool_radius_mm, poses)?, header))
+}
+
+impl ProgramHeader {
+    /// Verification options for the tolerances the program was made for: its scallop, and
+    /// its chordal tolerance as the gouge tolerance; defaults where it says nothing.
+    pub fn options(&self) -> VerifyOptions {
+        let mut o = VerifyOptions::default();
+        if let Some(h) = self.scallop_mm {
+            o.scallop_mm = h;
+        }
+        if let Some(c) = self.chordal_mm {
+            o.gouge_tolerance_mm = c;
+        }
+        o
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::machine::builtin;
 
     #[test]
-    fn reads_modal_moves_units_and_header() {
-        let text = "%\n(tool: ball-end radius 0.5 mm, scallop 0.01 mm, chordal 0.005 mm)\nG21 G90 G17\nG0 X1 Y2 Z3\nG1 Z1.5 F100\nX-1.25\nG91 X1\nG20 G90 X1 Y0 Z0\nM2\nG0 X9\n%\n";
-        let p = read_3axis(text).unwrap();
-        assert_eq!(p.header_tool_radius_mm, Some(0.5));
-        assert_eq!(p.header_scallop_mm, Some(0.01));
-        assert_eq!(p.header_chordal_mm, Some(0.005));
-        let tips: Vec<[f64; 3]> = p.tips.iter().map(|t| [t.tip.x, t.tip.y, t.tip.z]).collect();
+    fn header_and_moves() {
+        let text = "%\n(tool: T1 ball-end radius 0.5 mm, scallop 0.01 mm, chordal 0.005 mm)\nG21 G90 G17\nG0 X1 Y2 Z3\nG1 Z1.5 F100\nX-1.25\nG53 G0 Z0\nG0 X0 Y0 Z5\nM2\n%\n";
+        let h = ProgramHeader::parse(text);
         assert_eq!(
-            tips,
+            (h.tool_radius_mm, h.scallop_mm, h.chordal_mm),
+            (Some(0.5), Some(0.01), Some(0.005))
+        );
+        let m = builtin("3-axis").unwrap();
+        let tips = read_tool_poses(text, &m, Dialect::LinuxCnc).unwrap();
+        let xyz: Vec<Option<[f64; 3]>> = tips
+            .iter()
+            .map(|t| t.map(|t| [t.tip.x, t.tip.y, t.tip.z]))
+            .collect();
+        assert_eq!(
+            xyz,
             vec![
-                [1.0, 2.0, 3.0],
-                [1.0, 2.0, 1.5],
-                [-1.25, 2.0, 1.5],
-                [-0.25, 2.0, 1.5],
-                [25.4, 0.0, 0.0]
+                Some([1.0, 2.0, 3.0]),
+                Some([1.0, 2.0, 1.5]),
+                Some([-1.25, 2.0, 1.5]),
+                None,
+                Some([0.0, 0.0, 5.0])
             ]
         );
-        assert_eq!(p.tips[1].line, 5);
+        assert_eq!(tips[1].unwrap().line, 5);
+        assert!(tips
+            .iter()
+            .flatten()
+            .all(|t| t.tool_axis == crate::geom::Vector3::z()));
     }
 
     #[test]
     fn errors_name_the_line() {
-        for (text, line, what) in [
-            ("G0 X0 Y0 Z0\nG2 X1 Y1 I0 J1\n", 2, "arcs"),
-            ("G0 X0 Y0 Z0 A30\n", 1, "rotary"),
-            ("G1 X0 Y0 Z0\nG1 Xabc\n", 2, "number"),
-            ("X1 Y1 Z1\n", 1, "motion mode"),
-            ("G1 X0 Y0 Z0 (open\n", 1, "not closed"),
-            ("G28\n", 1, "G28"),
-            ("(nothing)\n", 1, "no move"),
-        ] {
-            let e = read_3axis(text).unwrap_err().to_string();
-            assert!(
-                e.contains(&format!("line {line}")) && e.contains(what),
-                "{text:?}: {e}"
-            );
-        }
+        let m = builtin("3-axis").unwrap();
+        let e = read_tool_poses("G0 X0 Y0 Z0\nG2 X1 Y1 I0 J1\n", &m, Dialect::LinuxCnc)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 2"), "{e}");
+        let e = read_tool_poses("(nothing)\n", &m, Dialect::LinuxCnc)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no move"), "{e}");
     }
 }

@@ -1,7 +1,7 @@
 //! Per-vertex values of a tessellation from the dense samples, for the page's heat map.
 //!
-//! Each sample goes to the nearest tessellation vertex of its own patch; a vertex shows the
-//! worst of its samples: the deepest gouge if any (negative, mm), else the most material
+//! Each sample goes to the nearest tessellation vertex on the same side of the surface (its
+//! normal within 90° of the sample's); a vertex shows the worst of its samples: the deepest gouge if any (negative, mm), else the most material
 //! left (mm), `+∞` where the tool never came near. Vertices that received no sample (a
 //! tessellation finer than the sampling) are measured directly by the caller.
 
@@ -16,7 +16,6 @@ const MAX_CELLS: usize = 1 << 21;
 pub struct HeatMap {
     positions: Vec<Point3>,
     normals: Vec<Vector3>,
-    patch: Vec<u32>,
     origin: Point3,
     cell: f64,
     dims: [usize; 3],
@@ -61,15 +60,12 @@ impl HeatMap {
                 n.try_normalize(0.0).unwrap_or_else(Vector3::z)
             })
             .collect();
-        let mut patch = vec![u32::MAX; nv];
         let mut edge_sum = 0.0;
         let mut edges = 0usize;
-        for (t, tri) in mesh.indices.chunks_exact(3).enumerate() {
-            let pid = mesh.patch_ids.get(t).copied().unwrap_or(0);
+        for tri in mesh.indices.chunks_exact(3) {
             for k in 0..3 {
                 let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
                 if a < nv && b < nv {
-                    patch[a] = pid;
                     edge_sum += (positions[a] - positions[b]).norm();
                     edges += 1;
                 }
@@ -101,7 +97,6 @@ impl HeatMap {
         let mut map = HeatMap {
             positions,
             normals,
-            patch,
             origin,
             cell,
             dims,
@@ -141,8 +136,8 @@ impl HeatMap {
         (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
     }
 
-    /// The nearest vertex of patch `patch` to `p` within two cells.
-    fn nearest(&self, patch: u32, p: &Point3) -> Option<usize> {
+    /// The nearest vertex to `p` whose normal is within 90° of `n`, within two cells.
+    fn nearest(&self, p: &Point3, n: &Vector3) -> Option<usize> {
         let c = self.coords(p);
         let mut best: Option<(f64, usize)> = None;
         for ring in 1..=2usize {
@@ -155,7 +150,7 @@ impl HeatMap {
                         let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
                         for &v in &self.items[s..e] {
                             let v = v as usize;
-                            if self.patch[v] == patch {
+                            if self.normals[v].dot(n) > 0.0 {
                                 let d = (self.positions[v] - p).norm_squared();
                                 if best.is_none_or(|(bd, bv)| d < bd || (d == bd && v < bv)) {
                                     best = Some((d, v));
@@ -172,9 +167,9 @@ impl HeatMap {
         best.map(|(_, v)| v)
     }
 
-    /// Records a sample's value at `p` on patch `patch`.
-    pub fn add(&mut self, patch: u32, p: &Point3, value: f32) {
-        if let Some(v) = self.nearest(patch, p) {
+    /// Records a sample's value at `p`, where the surface normal (`S_u × S_v`) is `n`.
+    pub fn add(&mut self, p: &Point3, n: &Vector3, value: f32) {
+        if let Some(v) = self.nearest(p, n) {
             self.values[v] = worse(self.values[v], value);
         }
     }

@@ -6,10 +6,10 @@
 //! JavaScript as a thrown `Error` whose message says what to fix.
 
 use crate::error::Error;
-use crate::machine::{self, JobInfo};
+use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions, PlanReport, Toolpath};
-use crate::surface::tessellate::{self, Tessellation};
+use crate::surface::tessellate::Tessellation;
 use crate::verify::{self, CutterPath, Verification, VerifyOptions};
 use wasm_bindgen::prelude::*;
 
@@ -36,6 +36,32 @@ pub fn sample_names() -> Vec<String> {
         .iter()
         .map(|s| s.name.to_string())
         .collect()
+}
+
+/// Names of the built-in machines (`3-axis`, `table-table-ac`, ...).
+#[wasm_bindgen(js_name = machineNames)]
+pub fn machine_names() -> Vec<String> {
+    machine::MACHINES
+        .iter()
+        .map(|m| m.name.to_string())
+        .collect()
+}
+
+/// Names of the G-code dialects (`linuxcnc`, `fanuc`, ...).
+#[wasm_bindgen(js_name = dialectNames)]
+pub fn dialect_names() -> Vec<String> {
+    machine::DIALECTS
+        .iter()
+        .map(|(_, n, _)| n.to_string())
+        .collect()
+}
+
+/// A built-in machine as the JSON text users edit (see the README's "Machines").
+#[wasm_bindgen(js_name = machineJson)]
+pub fn machine_json(name: &str) -> Result<String, JsError> {
+    machine::builtin(name)
+        .map(|m| machine::to_json(&m))
+        .map_err(js_err)
 }
 
 /// The crate version, for page footers and G-code headers.
@@ -81,6 +107,44 @@ impl WasmModel {
             .map_err(|e| JsError::new(&e.to_string()))
     }
 
+    /// Positions of the extraordinary points on the surface, `x y z` each (mm).
+    #[wasm_bindgen(js_name = extraordinaryPoints)]
+    pub fn extraordinary_points(&self) -> js_sys::Float64Array {
+        let v: Vec<f64> = self
+            .model
+            .extraordinary_positions()
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.z])
+            .collect();
+        js_sys::Float64Array::from(&v[..])
+    }
+
+    /// Evaluates point and first and second derivatives on an `n × n` grid of every face and
+    /// returns the number of evaluations; a timing hook for the wasm benchmark script.
+    #[wasm_bindgen(js_name = benchDerivs)]
+    pub fn bench_derivs(&self, n: u32) -> f64 {
+        let mut count = 0.0;
+        let mut acc = 0.0;
+        let n = n.max(1) as usize;
+        for f in 0..self.model.surface.faces().len() {
+            for k in 0..n * n {
+                let (i, j) = (k % n, k / n);
+                let d = self.model.surface.derivs(
+                    f,
+                    (i as f64 + 0.37) / n as f64,
+                    (j as f64 + 0.61) / n as f64,
+                );
+                acc += d.point.x + d.suu.y + d.svv.z;
+                count += 1.0;
+            }
+        }
+        if acc.is_nan() {
+            -count
+        } else {
+            count
+        }
+    }
+
     /// Triangles of the surface within `chordal_mm` (mm) of it.
     pub fn tessellate(&self, chordal_mm: f64) -> Result<WasmMesh, JsError> {
         if !(chordal_mm.is_finite() && chordal_mm > 0.0) {
@@ -90,7 +154,7 @@ impl WasmModel {
             )));
         }
         Ok(WasmMesh {
-            mesh: tessellate::tessellate(&self.model.surface, chordal_mm),
+            mesh: self.model.tessellate(chordal_mm),
         })
     }
 
@@ -122,18 +186,17 @@ impl WasmModel {
         let path = isoparametric::plan_zigzag(&self.model, &opts, &mut cb).map_err(js_err)?;
         let mut report = path.report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
         report.plan_ms = now_ms() - t0;
-        let gcode = machine::gcode_3axis(
-            &path,
-            &opts,
-            &JobInfo {
-                model: self.model.name.clone(),
-                strategy: "isoparametric".into(),
-            },
-        );
+        let job = JobInfo {
+            model: self.model.name.clone(),
+            strategy: "isoparametric".into(),
+        };
+        let gcode = machine::gcode_3axis(&path, &opts, &job).map_err(js_err)?;
         Ok(WasmPlan {
             path,
             report,
             gcode,
+            opts,
+            job,
         })
     }
 }
@@ -171,6 +234,8 @@ pub struct WasmPlan {
     path: Toolpath,
     report: PlanReport,
     gcode: String,
+    opts: PlanOptions,
+    job: JobInfo,
 }
 
 #[wasm_bindgen(js_class = Plan)]
@@ -223,9 +288,21 @@ impl WasmPlan {
     pub fn report(&self) -> Result<JsValue, JsError> {
         serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))
     }
-    /// The G-code program (mm).
+    /// The G-code program (3-axis, plain dialect, mm).
     pub fn gcode(&self) -> String {
         self.gcode.clone()
+    }
+
+    /// The program for a machine, dialect and units: `machine` is a built-in machine name
+    /// (see `machineNames()`) or the text of a machine JSON file; `dialect` one of
+    /// `dialectNames()`; `units` `mm` or `inch`. Throws with a message naming the move when
+    /// the machine cannot do the path.
+    #[wasm_bindgen(js_name = gcodeFor)]
+    pub fn gcode_for(&self, machine: &str, dialect: &str, units: &str) -> Result<String, JsError> {
+        let m = machine::resolve(machine).map_err(js_err)?;
+        let d = Dialect::parse(dialect).map_err(js_err)?;
+        let u = Units::parse(units).map_err(js_err)?;
+        machine::post(&self.path, &self.opts, &self.job, &m, d, u).map_err(js_err)
     }
 }
 
@@ -250,19 +327,6 @@ fn verify_options(base: VerifyOptions, options: JsValue) -> Result<VerifyOptions
         .map_err(|e| JsError::new(&format!("invalid verify options: {e}")))
 }
 
-/// Defaults taken from a program's header: the scallop asked for and the chordal tolerance
-/// (as the gouge tolerance).
-fn header_defaults(prog: &verify::gcode::GcodeProgram) -> VerifyOptions {
-    let mut o = VerifyOptions::default();
-    if let Some(h) = prog.header_scallop_mm {
-        o.scallop_mm = h;
-    }
-    if let Some(c) = prog.header_chordal_mm {
-        o.gouge_tolerance_mm = c;
-    }
-    o
-}
-
 #[wasm_bindgen(js_class = Model)]
 impl WasmModel {
     /// Simulates the ball-end cut of `plan` on this model and measures scallops and gouges.
@@ -276,9 +340,9 @@ impl WasmModel {
         mesh: &WasmMesh,
         options: JsValue,
     ) -> Result<WasmVerification, JsError> {
-        let base = verify::gcode::read_3axis(&plan.gcode)
-            .map(|p| header_defaults(&p))
-            .unwrap_or_default();
+        let base = VerifyOptions::default()
+            .with_scallop(plan.opts.scallop_mm)
+            .with_gouge_tolerance(plan.opts.chordal_mm);
         let opts = verify_options(base, options)?;
         let path = CutterPath::from_toolpath(&plan.path).map_err(js_err)?;
         let t0 = now_ms();
@@ -292,19 +356,25 @@ impl WasmModel {
         })
     }
 
-    /// As `verify`, for a three-axis G-code program (tool-tip X Y Z, as `plan` writes it)
-    /// cut with a ball-end of radius `tool_radius_mm` (mm).
+    /// As `verify`, for a program (any dialect the project writes, for `machine`, a
+    /// built-in name or machine JSON, and `dialect`, as for `gcodeFor`) cut with a ball-end
+    /// of radius `tool_radius_mm` (mm). The scallop and gouge tolerance default to those in
+    /// the program's header.
     #[wasm_bindgen(js_name = verifyGcode)]
     pub fn verify_gcode(
         &self,
         gcode: &str,
         tool_radius_mm: f64,
+        machine: &str,
+        dialect: &str,
         mesh: &WasmMesh,
         options: JsValue,
     ) -> Result<WasmVerification, JsError> {
-        let prog = verify::gcode::read_3axis(gcode).map_err(js_err)?;
-        let opts = verify_options(header_defaults(&prog), options)?;
-        let path = CutterPath::from_tool_tips(tool_radius_mm, prog.tips).map_err(js_err)?;
+        let m = machine::resolve(machine).map_err(js_err)?;
+        let d = Dialect::parse(dialect).map_err(js_err)?;
+        let (path, header) =
+            verify::gcode::read_program(gcode, tool_radius_mm, &m, d).map_err(js_err)?;
+        let opts = verify_options(header.options(), options)?;
         let t0 = now_ms();
         let (summary, heat) =
             verify::verify_with_heat_map(&self.model.surface, &path, &opts, &mesh.mesh)

@@ -1,0 +1,27 @@
+// Timing of the wasm build in Node: evaluation throughput (point + first and second
+// derivatives) on the keycap and the T-junction sample, and planning time per sample.
+// Usage: scripts/build-wasm && node scripts/bench-wasm.mjs
+import { readFileSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
+
+const pkg = fileURLToPath(new URL('../www/pkg/', import.meta.url));
+const wasm = await import(pkg + 'tspath.js');
+await wasm.default({ module_or_path: readFileSync(pkg + 'tspath_bg.wasm') });
+
+function best(fn, runs = 7) {
+  let t = Infinity;
+  for (let i = 0; i < runs; i++) {
+    const t0 = performance.now();
+    fn();
+    t = Math.min(t, performance.now() - t0);
+  }
+  return t;
+}
+
+for (const name of ['keycap-convex', 'tjunction']) {
+  const m = wasm.Model.sample(name);
+  let count = 0;
+  const ms = best(() => { count = m.benchDerivs(16); });
+  console.log(`eval ${name}: ${count} points+derivatives in ${ms.toFixed(2)} ms = ${(count / ms / 1000).toFixed(2)} M/s`);
+  m.free();
+}

@@ -1,0 +1,676 @@
+//! Patch layout: a partition of the surface into rectangular patches, each with its own
+//! `(u, v)` in `[0,1]²`, and which patches meet along a side or only at a corner.
+//!
+//! Patch boundaries are knot lines traced from extraordinary points (along every edge) and
+//! from concave corners of the domain (holes, notches: along the edges that continue the
+//! boundary), straight on through regular vertices and across faces at T-junction stems,
+//! until they reach the boundary, an extraordinary point, or a vertex another line has
+//! passed. The faces are cut along those lines into cells; cells joined across uncut edges
+//! form the patches.
+//!
+//! Owns: tracing, cells, patch charts and connections, and patch evaluation. Must not:
+//! change the mesh or the surface.
+
+use crate::geom::Point3;
+use crate::surface::{Surface, SurfaceDerivs};
+use crate::tmesh::walk::{rot, unit, LineStep};
+use crate::tmesh::{TMesh, KNOT_MATCH_REL};
+use serde::{Deserialize, Serialize};
+use std::collections::{HashMap, HashSet};
+
+/// A rectangle of one domain face inside a patch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Piece {
+    /// Index of the face in [`Surface::faces`].
+    pub face: u32,
+    /// `[x0, x1, y0, y1]` in the face's knot coordinates.
+    pub local: [f64; 4],
+    /// Placement in the patch chart: `chart = rot(quarter_turns)·local + offset`.
+    pub quarter_turns: u8,
+    pub offset: [f64; 2],
+}
+
+/// One rectangular patch.
+#[derive(Debug, Clone)]
+pub struct Patch {
+    pub pieces: Vec<Piece>,
+    /// Size of the chart in knot units (`u` spans `width`, `v` spans `height`).
+    pub width: f64,
+    pub height: f64,
+    s_breaks: Vec<f64>,
+    t_breaks: Vec<f64>,
+    /// Piece of each chart cell, row-major over `(t, s)`.
+    cell_piece: Vec<u32>,
+}
+
+/// How two patches touch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ConnectionKind {
+    /// Along a stretch of their sides.
+    Boundary,
+    /// At a single point only.
+    Corner,
+}
+
+/// Two patches that touch. Sides are numbered 0: `v = 0`, 1: `u = 1`, 2: `v = 1`,
+/// 3: `u = 0`; corners 0: `(0,0)`, 1: `(1,0)`, 2: `(1,1)`, 3: `(0,1)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Connection {
+    pub a: u32,
+    pub b: u32,
+    pub kind: ConnectionKind,
+    /// For boundary connections the sides of `a` and `b` that touch.
+    pub sides: Option<(u8, u8)>,
+}
+
+/// The layout of a model.
+#[derive(Debug, Clone)]
+pub struct PatchLayout {
+    pub patches: Vec<Patch>,
+    pub connections: Vec<Connection>,
+}
+
+/// A cell: a rectangle of a domain face between cut lines.
+#[derive(Debug, Clone, Copy)]
+struct Cell {
+    face: u32,
+    rect: [f64; 4],
+}
+
+struct Cells {
+    cells: Vec<Cell>,
+    /// Per domain face: its first cell, and its cut positions `xs`, `ys` (0 and the size
+    /// included).
+    first: Vec<usize>,
+    xs: Vec<Vec<f64>>,
+    ys: Vec<Vec<f64>>,
+}
+
+impl Cells {
+    fn id(&self, face: usize, i: usize, j: usize) -> usize {
+        self.first[face] + j * (self.xs[face].len() - 1) + i
+    }
+
+    /// Cells along side `side` of domain face `face`, with their ranges along that side
+    /// (measured from the side's first corner, as half-edge offsets are).
+    fn along_side(&self, face: usize, side: u8, w: f64, h: f64) -> Vec<(usize, f64, f64)> {
+        let (xs, ys) = (&self.xs[face], &self.ys[face]);
+        let (nx, ny) = (xs.len() - 1, ys.len() - 1);
+        match side {
+            0 => (0..nx)
+                .map(|i| (self.id(face, i, 0), xs[i], xs[i + 1]))
+                .collect(),
+            1 => (0..ny)
+                .map(|j| (self.id(face, nx - 1, j), ys[j], ys[j + 1]))
+                .collect(),
+            2 => (0..nx)
+                .map(|i| (self.id(face, i, ny - 1), w - xs[i + 1], w - xs[i]))
+                .collect(),
+            _ => (0..ny)
+                .map(|j| (self.id(face, 0, j), h - ys[j + 1], h - ys[j]))
+                .collect(),
+        }
+    }
+}
+
+fn find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
+/// Placement of a face in a chart: `chart = rot(k)·local + offset`.
+type Placement = (u8, [f64; 2]);
+
+impl PatchLayout {
+    /// Computes the layout of a surface built from `mesh`.
+    pub fn build(mesh: &TMesh, surface: &Surface) -> PatchLayout {
+        let domain: HashMap<u32, usize> = surface
+            .faces()
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.mesh_face, i))
+            .collect();
+        let is_domain = |f: u32| domain.contains_key(&f);
+        let nv = mesh.vertex_count() as u32;
+        // Vertices on the domain's boundary: on the mesh boundary or next to a face that
+        // carries no surface.
+        let on_boundary: Vec<bool> = (0..nv)
+            .map(|v| {
+                mesh.is_boundary_vertex(v)
+                    || mesh
+                        .outgoing(v)
+                        .iter()
+                        .any(|&h| !is_domain(mesh.he(h).face))
+            })
+            .collect();
+        let domain_angle = |v: u32| -> u32 {
+            mesh.outgoing(v)
+                .iter()
+                .filter(|&&h| is_domain(mesh.he(h).face))
+                .map(|&h| mesh.sector_quarters(h))
+                .sum()
+        };
+        let extraordinary: Vec<bool> = (0..nv).map(|v| mesh.is_extraordinary(v)).collect();
+        let seeds: Vec<u32> = (0..nv)
+            .filter(|&v| {
+                extraordinary[v as usize] || (on_boundary[v as usize] && domain_angle(v) == 3)
+            })
+            .collect();
+
+        // Trace the lines.
+        let mut on_cut = vec![false; nv as usize];
+        let mut cut_edges: HashSet<u32> = HashSet::new();
+        let mut face_cuts: Vec<(Vec<f64>, Vec<f64>)> =
+            vec![(Vec::new(), Vec::new()); surface.faces().len()];
+        for &v in &seeds {
+            on_cut[v as usize] = true;
+        }
+        for &v in &seeds {
+            for h in mesh.outgoing(v) {
+                let e = mesh.he(h);
+                let interior =
+                    is_domain(e.face) && e.twin.is_some_and(|t| is_domain(mesh.he(t).face));
+                if !interior || cut_edges.contains(&h) {
+                    continue;
+                }
+                let steps = {
+                    let on_cut_ref = &on_cut;
+                    mesh.trace_line(h, &mut |w| {
+                        extraordinary[w as usize]
+                            || on_boundary[w as usize]
+                            || on_cut_ref[w as usize]
+                    })
+                };
+                for s in steps {
+                    match s {
+                        LineStep::Edge(e) => {
+                            cut_edges.insert(e);
+                            let he = mesh.he(e);
+                            if let Some(t) = he.twin {
+                                cut_edges.insert(t);
+                            }
+                            on_cut[he.origin as usize] = true;
+                            on_cut[mesh.he(he.next).origin as usize] = true;
+                        }
+                        LineStep::Cross { face, side, pos } => {
+                            let Some(&d) = domain.get(&face) else {
+                                continue;
+                            };
+                            let f = &mesh.faces()[face as usize];
+                            match side {
+                                0 => face_cuts[d].0.push(pos),
+                                2 => face_cuts[d].0.push(f.width - pos),
+                                1 => face_cuts[d].1.push(pos),
+                                _ => face_cuts[d].1.push(f.height - pos),
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        // Cells.
+        let mut cells = Cells {
+            cells: Vec::new(),
+            first: Vec::new(),
+            xs: Vec::new(),
+            ys: Vec::new(),
+        };
+        for (d, f) in surface.faces().iter().enumerate() {
+            let positions = |mut c: Vec<f64>, len: f64| {
+                let tol = KNOT_MATCH_REL * len;
+                c.retain(|&x| x > tol && x < len - tol);
+                c.sort_by(f64::total_cmp);
+                c.dedup_by(|a, b| (*a - *b).abs() <= tol);
+                let mut out = vec![0.0];
+                out.extend(c);
+                out.push(len);
+                out
+            };
+            let xs = positions(face_cuts[d].0.clone(), f.width);
+            let ys = positions(face_cuts[d].1.clone(), f.height);
+            cells.first.push(cells.cells.len());
+            for j in 0..ys.len() - 1 {
+                for i in 0..xs.len() - 1 {
+                    cells.cells.push(Cell {
+                        face: d as u32,
+                        rect: [xs[i], xs[i + 1], ys[j], ys[j + 1]],
+                    });
+                }
+            }
+            cells.xs.push(xs);
+            cells.ys.push(ys);
+        }
+
+        // Join cells across uncut edges; remember the edges between cells for placement.
+        let n = cells.cells.len();
+        let mut parent: Vec<usize> = (0..n).collect();
+        // (cell a, cell b, half-edge of a's face, half-edge of b's face, cut)
+        let mut links: Vec<(usize, usize, u32, u32, bool)> = Vec::new();
+        for (hi, h) in mesh.half_edges().iter().enumerate() {
+            let hi = hi as u32;
+            let Some(t) = h.twin else { continue };
+            if hi > t {
+                continue;
+            }
+            let o = mesh.he(t);
+            let (Some(&da), Some(&db)) = (domain.get(&h.face), domain.get(&o.face)) else {
+                continue;
+            };
+            if h.knot <= 0.0 {
+                continue;
+            }
+            let (fa, fb) = (
+                &mesh.faces()[h.face as usize],
+                &mesh.faces()[o.face as usize],
+            );
+            let tol = KNOT_MATCH_REL * h.knot;
+            let side_a = cells.along_side(da, h.side, fa.width, fa.height);
+            let side_b = cells.along_side(db, o.side, fb.width, fb.height);
+            let cut = cut_edges.contains(&hi);
+            for &(ca, a0, a1) in &side_a {
+                let lo = a0.max(h.offset);
+                let hi_a = a1.min(h.offset + h.knot);
+                if hi_a - lo <= tol {
+                    continue;
+                }
+                for &(cb, b0, b1) in &side_b {
+                    // b's position p maps to a's position h.offset + h.knot - (p - o.offset).
+                    let m0 = h.offset + h.knot - (b1 - o.offset);
+                    let m1 = h.offset + h.knot - (b0 - o.offset);
+                    if m1.min(hi_a) - m0.max(lo) > tol {
+                        links.push((ca, cb, hi, t, cut));
+                        if !cut {
+                            let (ra, rb) = (find(&mut parent, ca), find(&mut parent, cb));
+                            parent[ra] = rb;
+                        }
+                    }
+                }
+            }
+        }
+
+        // Components in order of their first cell, placed in charts.
+        let mut comp_of = vec![usize::MAX; n];
+        let mut comps: Vec<Vec<usize>> = Vec::new();
+        let mut root_comp: HashMap<usize, usize> = HashMap::new();
+        for c in 0..n {
+            let r = find(&mut parent, c);
+            let k = *root_comp.entry(r).or_insert_with(|| {
+                comps.push(Vec::new());
+                comps.len() - 1
+            });
+            comps[k].push(c);
+            comp_of[c] = k;
+        }
+        let mut adjacency: Vec<Vec<(usize, u32, u32)>> = vec![Vec::new(); n];
+        for &(a, b, ha, hb, cut) in &links {
+            if !cut {
+                adjacency[a].push((b, ha, hb));
+                adjacency[b].push((a, hb, ha));
+            }
+        }
+        let mut patches: Vec<Patch> = Vec::new();
+        let mut patch_of_cell = vec![0u32; n];
+        for comp in &comps {
+            let placed = place_component(mesh, &cells, comp, &adjacency);
+            let chunks: Vec<Vec<(usize, Placement)>> = match placed {
+                Some(p) => vec![p],
+                // Not a rectangle (e.g. a band closing on itself): one patch per cell.
+                None => comp.iter().map(|&c| vec![(c, (0, [0.0, 0.0]))]).collect(),
+            };
+            for chunk in chunks {
+                let id = patches.len() as u32;
+                for &(c, _) in &chunk {
+                    patch_of_cell[c] = id;
+                }
+                patches.push(Patch::from_cells(&cells, &chunk));
+            }
+        }
+
+        // Connections.
+        let mut boundary: HashSet<(u32, u32)> = HashSet::new();
+        let mut connections: Vec<Connection> = Vec::new();
+        let mut add_boundary = |a: u32, b: u32, sa: u8, sb: u8, out: &mut Vec<Connection>| {
+            if a == b {
+                return;
+            }
+            let key = (a.min(b), a.max(b));
+            if boundary.insert(key) {
+                let sides = if a < b { (sa, sb) } else { (sb, sa) };
+                out.push(Connection {
+                    a: key.0,
+                    b: key.1,
+                    kind: ConnectionKind::Boundary,
+                    sides: Some(sides),
+                });
+            }
+        };
+        for &(ca, cb, ha, hb, cut) in &links {
+            if !cut {
+                continue;
+            }
+            let (pa, pb) = (patch_of_cell[ca], patch_of_cell[cb]);
+            let sa = patches[pa as usize].side_of(mesh, &cells.cells[ca], ha);
+            let sb = patches[pb as usize].side_of(mesh, &cells.cells[cb], hb);
+            add_boundary(pa, pb, sa, sb, &mut connections);
+        }
+        // Cells of one face separated by a cut line inside it.
+        for d in 0..surface.faces().len() {
+            let (nx, ny) = (cells.xs[d].len() - 1, cells.ys[d].len() - 1);
+            for j in 0..ny {
+                for i in 0..nx {
+                    let c = cells.id(d, i, j);
+                    for (di, dj) in [(1usize, 0usize), (0, 1)] {
+                        if i + di >= nx || j + dj >= ny {
+                            continue;
+                        }
+                        let o = cells.id(d, i + di, j + dj);
+                        let (pa, pb) = (patch_of_cell[c], patch_of_cell[o]);
+                        let (x, y) = if di == 1 {
+                            (
+                                cells.xs[d][i + 1],
+                                0.5 * (cells.ys[d][j] + cells.ys[d][j + 1]),
+                            )
+                        } else {
+                            (
+                                0.5 * (cells.xs[d][i] + cells.xs[d][i + 1]),
+                                cells.ys[d][j + 1],
+                            )
+                        };
+                        let sa = patches[pa as usize].side_at(d as u32, [x, y]);
+                        let sb = patches[pb as usize].side_at(d as u32, [x, y]);
+                        add_boundary(pa, pb, sa, sb, &mut connections);
+                    }
+                }
+            }
+        }
+        // Corner connections: patches that share a mesh vertex but no side.
+        let mut corner: HashSet<(u32, u32)> = HashSet::new();
+        for v in 0..nv {
+            let mut touching: Vec<u32> = Vec::new();
+            for h in mesh.outgoing(v) {
+                let e = mesh.he(h);
+                let Some(&d) = domain.get(&e.face) else {
+                    continue;
+                };
+                let f = &mesh.faces()[e.face as usize];
+                let (lo, _) = mesh.local_frame(h);
+                let p = [lo[0].clamp(0.0, f.width), lo[1].clamp(0.0, f.height)];
+                for c in cells.first[d]
+                    ..cells.first[d] + (cells.xs[d].len() - 1) * (cells.ys[d].len() - 1)
+                {
+                    let r = cells.cells[c].rect;
+                    let tol = KNOT_MATCH_REL * f.width.max(f.height);
+                    if p[0] >= r[0] - tol
+                        && p[0] <= r[1] + tol
+                        && p[1] >= r[2] - tol
+                        && p[1] <= r[3] + tol
+                    {
+                        touching.push(patch_of_cell[c]);
+                    }
+                }
+            }
+            touching.sort_unstable();
+            touching.dedup();
+            for (i, &a) in touching.iter().enumerate() {
+                for &b in &touching[i + 1..] {
+                    if !boundary.contains(&(a, b)) && corner.insert((a, b)) {
+                        connections.push(Connection {
+                            a,
+                            b,
+                            kind: ConnectionKind::Corner,
+                            sides: None,
+                        });
+                    }
+                }
+            }
+        }
+        connections.sort_by_key(|c| (c.a, c.b));
+        PatchLayout {
+            patches,
+            connections,
+        }
+    }
+
+    /// Number of patches.
+    pub fn len(&self) -> usize {
+        self.patches.len()
+    }
+
+    /// True if there are no patches.
+    pub fn is_empty(&self) -> bool {
+        self.patches.is_empty()
+    }
+}
+
+/// Places the cells of a component in one chart by walking across shared edges. `None` if
+/// the placement is inconsistent or the cells do not fill a rectangle.
+fn place_component(
+    mesh: &TMesh,
+    cells: &Cells,
+    comp: &[usize],
+    adjacency: &[Vec<(usize, u32, u32)>],
+) -> Option<Vec<(usize, Placement)>> {
+    let mut placed: HashMap<usize, Placement> = HashMap::new();
+    let mut face_pl: HashMap<u32, Placement> = HashMap::new();
+    let start = comp[0];
+    placed.insert(start, (0, [0.0, 0.0]));
+    face_pl.insert(cells.cells[start].face, (0, [0.0, 0.0]));
+    let mut queue = std::collections::VecDeque::from([start]);
+    while let Some(c) = queue.pop_front() {
+        let (k, off) = placed[&c];
+        for &(o, h, t) in &adjacency[c] {
+            let cand = if cells.cells[o].face == cells.cells[c].face {
+                (k, off)
+            } else {
+                let (lo, side) = mesh.local_frame(h);
+                let knot = mesh.he(h).knot;
+                let d = unit(side);
+                let r = rot(k, [lo[0] + knot * d[0], lo[1] + knot * d[1]]);
+                let pos = [r[0] + off[0], r[1] + off[1]];
+                let dir = (k + side + 2) % 4;
+                let (lo_t, side_t) = mesh.local_frame(t);
+                let kk = (dir + 4 - side_t) % 4;
+                let rt = rot(kk, lo_t);
+                (kk, [pos[0] - rt[0], pos[1] - rt[1]])
+            };
+            let face = cells.cells[o].face;
+            if let Some(&prev) = face_pl.get(&face) {
+                let scale = 1.0 + prev.1[0].abs().max(prev.1[1].abs());
+                if prev.0 != cand.0
+                    || (prev.1[0] - cand.1[0]).abs() + (prev.1[1] - cand.1[1]).abs() > 1e-7 * scale
+                {
+                    return None;
+                }
+            } else {
+                face_pl.insert(face, cand);
+            }
+            if let std::collections::hash_map::Entry::Vacant(e) = placed.entry(o) {
+                e.insert(cand);
+                queue.push_back(o);
+            }
+        }
+    }
+    if placed.len() != comp.len() {
+        return None;
+    }
+    // Rectangle check: the cells' areas add up to their bounding box.
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let mut area = 0.0;
+    for &c in comp {
+        let (a, b) = chart_rect(&cells.cells[c].rect, placed[&c]);
+        lo = [lo[0].min(a[0]), lo[1].min(a[1])];
+        hi = [hi[0].max(b[0]), hi[1].max(b[1])];
+        area += (b[0] - a[0]) * (b[1] - a[1]);
+    }
+    let box_area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+    if !(box_area > 0.0) || (area - box_area).abs() > 1e-9 * box_area {
+        return None;
+    }
+    let mut out: Vec<(usize, Placement)> = comp.iter().map(|&c| (c, placed[&c])).collect();
+    for (_, pl) in out.iter_mut() {
+        pl.1 = [pl.1[0] - lo[0], pl.1[1] - lo[1]];
+    }
+    Some(out)
+}
+
+/// The chart rectangle `(min, max)` of a local rectangle under a placement.
+fn chart_rect(r: &[f64; 4], (k, off): Placement) -> ([f64; 2], [f64; 2]) {
+    let a = rot(k, [r[0], r[2]]);
+    let b = rot(k, [r[1], r[3]]);
+    (
+        [a[0].min(b[0]) + off[0], a[1].min(b[1]) + off[1]],
+        [a[0].max(b[0]) + off[0], a[1].max(b[1]) + off[1]],
+    )
+}
+
+impl Patch {
+    fn from_cells(cells: &Cells, chunk: &[(usize, Placement)]) -> Patch {
+        let mut pieces = Vec::with_capacity(chunk.len());
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for &(c, pl) in chunk {
+            let cell = &cells.cells[c];
+            let (a, b) = chart_rect(&cell.rect, pl);
+            lo = [lo[0].min(a[0]), lo[1].min(a[1])];
+            hi = [hi[0].max(b[0]), hi[1].max(b[1])];
+            pieces.push(Piece {
+                face: cell.face,
+                local: cell.rect,
+                quarter_turns: pl.0,
+                offset: pl.1,
+            });
+        }
+        // A single-cell patch from a non-rectangular component is placed at its own origin.
+        for p in pieces.iter_mut() {
+            p.offset = [p.offset[0] - lo[0], p.offset[1] - lo[1]];
+        }
+        let (width, height) = (hi[0] - lo[0], hi[1] - lo[1]);
+        let tol = KNOT_MATCH_REL * width.max(height);
+        let mut s_breaks: Vec<f64> = Vec::new();
+        let mut t_breaks: Vec<f64> = Vec::new();
+        for p in &pieces {
+            let (a, b) = chart_rect(&p.local, (p.quarter_turns, p.offset));
+            s_breaks.extend([a[0], b[0]]);
+            t_breaks.extend([a[1], b[1]]);
+        }
+        for v in [&mut s_breaks, &mut t_breaks] {
+            v.sort_by(f64::total_cmp);
+            v.dedup_by(|a, b| (*a - *b).abs() <= tol);
+        }
+        let mut cell_piece = Vec::with_capacity((s_breaks.len() - 1) * (t_breaks.len() - 1));
+        for j in 0..t_breaks.len() - 1 {
+            for i in 0..s_breaks.len() - 1 {
+                let m = [
+                    0.5 * (s_breaks[i] + s_breaks[i + 1]),
+                    0.5 * (t_breaks[j] + t_breaks[j + 1]),
+                ];
+                let k = pieces
+                    .iter()
+                    .position(|p| {
+                        let (a, b) = chart_rect(&p.local, (p.quarter_turns, p.offset));
+                        m[0] >= a[0] && m[0] <= b[0] && m[1] >= a[1] && m[1] <= b[1]
+                    })
+                    .unwrap_or(0);
+                cell_piece.push(k as u32);
+            }
+        }
+        Patch {
+            pieces,
+            width,
+            height,
+            s_breaks,
+            t_breaks,
+            cell_piece,
+        }
+    }
+
+    /// The piece at chart point `(s, t)` and the face-knot coordinates there.
+    fn locate(&self, s: f64, t: f64) -> (&Piece, [f64; 2]) {
+        let ns = self.s_breaks.len() - 1;
+        let nt = self.t_breaks.len() - 1;
+        let i = self.s_breaks[1..ns]
+            .partition_point(|&b| b <= s)
+            .min(ns - 1);
+        let j = self.t_breaks[1..nt]
+            .partition_point(|&b| b <= t)
+            .min(nt - 1);
+        let p = &self.pieces[self.cell_piece[j * ns + i] as usize];
+        let local = rot(
+            (4 - p.quarter_turns) % 4,
+            [s - p.offset[0], t - p.offset[1]],
+        );
+        let x = local[0].clamp(p.local[0], p.local[1]);
+        let y = local[1].clamp(p.local[2], p.local[3]);
+        (p, [x, y])
+    }
+
+    /// Point and derivatives at patch parameters `(u, v)` in `[0,1]²`.
+    pub fn derivs(&self, surface: &Surface, u: f64, v: f64) -> SurfaceDerivs {
+        let (p, [x, y]) = self.locate(u * self.width, v * self.height);
+        let face = &surface.faces()[p.face as usize];
+        let d = face.derivs(x / face.width, y / face.height);
+        // (a, b) face parameters from (u, v): a = x / W_f with (x, y) = rot(-k)(s - off),
+        // s = u·W, t = v·H.
+        let m = rot((4 - p.quarter_turns) % 4, [1.0, 0.0]);
+        let n = rot((4 - p.quarter_turns) % 4, [0.0, 1.0]);
+        let j00 = m[0] * self.width / face.width;
+        let j10 = m[1] * self.width / face.height;
+        let j01 = n[0] * self.height / face.width;
+        let j11 = n[1] * self.height / face.height;
+        SurfaceDerivs {
+            point: d.point,
+            su: d.su * j00 + d.sv * j10,
+            sv: d.su * j01 + d.sv * j11,
+            suu: d.suu * (j00 * j00) + d.suv * (2.0 * j00 * j10) + d.svv * (j10 * j10),
+            suv: d.suu * (j00 * j01) + d.suv * (j00 * j11 + j10 * j01) + d.svv * (j10 * j11),
+            svv: d.suu * (j01 * j01) + d.suv * (2.0 * j01 * j11) + d.svv * (j11 * j11),
+        }
+    }
+
+    /// Point at patch parameters `(u, v)`.
+    pub fn subs(&self, surface: &Surface, u: f64, v: f64) -> Point3 {
+        let (p, [x, y]) = self.locate(u * self.width, v * self.height);
+        let face = &surface.faces()[p.face as usize];
+        face.subs(x / face.width, y / face.height)
+    }
+
+    /// Which side of the patch a face-local point of piece face `face` lies on.
+    fn side_at(&self, face: u32, local: [f64; 2]) -> u8 {
+        let p = self
+            .pieces
+            .iter()
+            .find(|p| {
+                p.face == face
+                    && local[0] >= p.local[0] - 1e-12
+                    && local[0] <= p.local[1] + 1e-12
+                    && local[1] >= p.local[2] - 1e-12
+                    && local[1] <= p.local[3] + 1e-12
+            })
+            .unwrap_or(&self.pieces[0]);
+        let r = rot(p.quarter_turns, local);
+        let c = [r[0] + p.offset[0], r[1] + p.offset[1]];
+        let d = [c[1], self.width - c[0], self.height - c[1], c[0]];
+        (0..4)
+            .min_by(|&a, &b| d[a].abs().total_cmp(&d[b].abs()))
+            .unwrap_or(0) as u8
+    }
+
+    /// The side of the patch on which half-edge `h` (bounding `cell`) lies.
+    fn side_of(&self, mesh: &TMesh, cell: &Cell, h: u32) -> u8 {
+        let (lo, side) = mesh.local_frame(h);
+        let e = mesh.he(h);
+        let d = unit(side);
+        let mid = [lo[0] + 0.5 * e.knot * d[0], lo[1] + 0.5 * e.knot * d[1]];
+        let mid = [
+            mid[0].clamp(cell.rect[0], cell.rect[1]),
+            mid[1].clamp(cell.rect[2], cell.rect[3]),
+        ];
+        self.side_at(cell.face, mid)
+    }
+}

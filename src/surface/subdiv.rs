@@ -1,0 +1,571 @@
+//! Catmull–Clark limit surfaces by local subdivision: a face's one-ring is cut out of the
+//! mesh, subdivided, and every child that has become regular is turned into a bicubic Bézier
+//! cell; children touching an extraordinary point are subdivided again, down to a fixed depth
+//! below which the limit point stands for the whole (sub-nanometre) region.
+//!
+//! Rules (homogeneous coordinates, so rational cages subdivide as NURCCs): face points are
+//! face averages; interior edge points `(a + b + f0 + f1)/4`; interior vertex points
+//! `(Q + 2R + (n − 3)v)/n`. Boundary edges are sharp: edge points are midpoints, boundary
+//! vertices `(a + 6v + b)/8`, and a vertex with one face (a corner) stays where it is.
+//! A regular face (interior corners of valence 4, boundary corners with two faces, corners
+//! with one) is a uniform bicubic B-spline patch of its 16 one-ring points, with points
+//! mirrored across sharp boundaries (`2·p_boundary − p_inner`).
+//!
+//! Owns: the local quad mesh, one subdivision step, regular-patch detection, the per-face
+//! quadtree of Bézier cells. Must not: know about T-junctions or knot intervals other than
+//! uniform ones (callers reject those near extraordinary points).
+
+use super::bezier::{BezierPatch, SurfaceDerivs};
+use crate::geom::{Point3, Vector3, Vector4};
+use std::collections::HashMap;
+
+/// Depth of subdivision after which the region next to an extraordinary point (2^-depth of
+/// the face's side, about 1e-12) is represented by its limit point.
+pub const MAX_DEPTH: usize = 40;
+
+/// A small quad mesh cut out around one face: homogeneous points, counter-clockwise quads,
+/// and for each boundary edge of the cut whether it is a true (sharp) boundary of the model
+/// or only where the cut ended.
+#[derive(Debug, Clone)]
+pub struct LocalMesh {
+    /// Homogeneous points, relative to `origin`.
+    pub pts: Vec<Vector4>,
+    /// Where the coordinates are measured from (mm). Subdivision near an extraordinary
+    /// point re-centres on its limit point at every level, so that coordinates shrink with
+    /// the region and keep their relative precision down to the deepest cells.
+    pub origin: Vector3,
+    pub quads: Vec<[u32; 4]>,
+    /// Undirected edges `(min, max)` that lie on the model's boundary.
+    pub sharp: std::collections::HashSet<(u32, u32)>,
+}
+
+/// The quadtree of a face evaluated by subdivision.
+// Leaves are stored inline: evaluation reads them without another indirection.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone)]
+pub enum Node {
+    /// A regular region: one Bézier cell over the node's square, with coordinates measured
+    /// from `origin` (mm).
+    Leaf { patch: BezierPatch, origin: Vector3 },
+    /// Four children: `[u low v low, u high v low, u low v high, u high v high]`.
+    Split(Box<[Node; 4]>),
+    /// The tiny region at an extraordinary point: its limit point (homogeneous).
+    Cap(Vector4),
+}
+
+impl Node {
+    /// Point and derivatives at `(u, v)` in the node's square `[0,1]²`.
+    pub fn derivs(&self, mut u: f64, mut v: f64) -> SurfaceDerivs {
+        let mut node = self;
+        let mut scale = 1.0;
+        loop {
+            match node {
+                Node::Leaf { patch, origin } => {
+                    let mut d = patch.derivs(u, v).scaled(scale, scale);
+                    d.point += origin;
+                    return d;
+                }
+                Node::Cap(h) => {
+                    return SurfaceDerivs {
+                        point: Point3::new(h.x / h.w, h.y / h.w, h.z / h.w),
+                        su: Vector3::zeros(),
+                        sv: Vector3::zeros(),
+                        suu: Vector3::zeros(),
+                        suv: Vector3::zeros(),
+                        svv: Vector3::zeros(),
+                    }
+                }
+                Node::Split(ch) => {
+                    let (hu, hv) = (u >= 0.5, v >= 0.5);
+                    u = if hu { 2.0 * u - 1.0 } else { 2.0 * u };
+                    v = if hv { 2.0 * v - 1.0 } else { 2.0 * v };
+                    scale *= 2.0;
+                    node = &ch[(hu as usize) + 2 * (hv as usize)];
+                }
+            }
+        }
+    }
+
+    /// Point only.
+    pub fn subs(&self, mut u: f64, mut v: f64) -> Point3 {
+        let mut node = self;
+        loop {
+            match node {
+                Node::Leaf { patch, origin } => return patch.subs(u, v) + origin,
+                Node::Cap(h) => return Point3::new(h.x / h.w, h.y / h.w, h.z / h.w),
+                Node::Split(ch) => {
+                    let (hu, hv) = (u >= 0.5, v >= 0.5);
+                    u = if hu { 2.0 * u - 1.0 } else { 2.0 * u };
+                    v = if hv { 2.0 * v - 1.0 } else { 2.0 * v };
+                    node = &ch[(hu as usize) + 2 * (hv as usize)];
+                }
+            }
+        }
+    }
+
+    /// Number of Bézier cells.
+    pub fn leaf_count(&self) -> usize {
+        match self {
+            Node::Leaf { .. } => 1,
+            Node::Cap(_) => 0,
+            Node::Split(ch) => ch.iter().map(Node::leaf_count).sum(),
+        }
+    }
+
+    /// Calls `f` with each leaf's square `[u0, u1, v0, v1]` and patch (in model
+    /// coordinates).
+    pub fn for_each_leaf(&self, f: &mut dyn FnMut([f64; 4], &BezierPatch)) {
+        fn walk(n: &Node, r: [f64; 4], f: &mut dyn FnMut([f64; 4], &BezierPatch)) {
+            match n {
+                Node::Leaf { patch, origin } => {
+                    let mut p = patch.clone();
+                    for c in p.cp.iter_mut().flatten() {
+                        let w = c.w;
+                        *c += Vector4::new(origin.x * w, origin.y * w, origin.z * w, 0.0);
+                    }
+                    f(r, &p)
+                }
+                Node::Cap(_) => {}
+                Node::Split(ch) => {
+                    let um = 0.5 * (r[0] + r[1]);
+                    let vm = 0.5 * (r[2] + r[3]);
+                    walk(&ch[0], [r[0], um, r[2], vm], f);
+                    walk(&ch[1], [um, r[1], r[2], vm], f);
+                    walk(&ch[2], [r[0], um, vm, r[3]], f);
+                    walk(&ch[3], [um, r[1], vm, r[3]], f);
+                }
+            }
+        }
+        walk(self, [0.0, 1.0, 0.0, 1.0], f);
+    }
+}
+
+/// Adjacency of a local mesh, built once per mesh.
+struct Adjacency {
+    /// Directed edge `(a, b)` → (quad, corner index of `a`).
+    directed: HashMap<(u32, u32), (u32, u8)>,
+    /// Quads around each vertex.
+    vertex_quads: Vec<Vec<u32>>,
+}
+
+impl Adjacency {
+    fn new(m: &LocalMesh) -> Self {
+        let mut directed = HashMap::with_capacity(m.quads.len() * 4);
+        let mut vertex_quads = vec![Vec::new(); m.pts.len()];
+        for (qi, q) in m.quads.iter().enumerate() {
+            for k in 0..4 {
+                directed.insert((q[k], q[(k + 1) % 4]), (qi as u32, k as u8));
+                vertex_quads[q[k] as usize].push(qi as u32);
+            }
+        }
+        Adjacency {
+            directed,
+            vertex_quads,
+        }
+    }
+
+    /// True if the undirected edge has a quad on one side only.
+    fn is_open(&self, a: u32, b: u32) -> bool {
+        !(self.directed.contains_key(&(a, b)) && self.directed.contains_key(&(b, a)))
+    }
+}
+
+/// How a vertex of a local mesh sits in the model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum VertexKind {
+    /// All its faces are in the local mesh and none of its edges is sharp.
+    Interior { faces: usize },
+    /// On the model's boundary, with all its faces present.
+    Boundary { faces: usize },
+    /// Some of its faces were cut away: its subdivision rule cannot be applied.
+    Incomplete,
+}
+
+fn edge_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+impl LocalMesh {
+    fn vertex_kind(&self, adj: &Adjacency, v: u32) -> VertexKind {
+        let quads = &adj.vertex_quads[v as usize];
+        let mut sharp = 0;
+        for &q in quads {
+            let quad = &self.quads[q as usize];
+            let k = quad
+                .iter()
+                .position(|&x| x == v)
+                .expect("vertex is in its quad");
+            for w in [quad[(k + 1) % 4], quad[(k + 3) % 4]] {
+                if adj.is_open(v, w) {
+                    if self.sharp.contains(&edge_key(v, w)) {
+                        sharp += 1;
+                    } else {
+                        return VertexKind::Incomplete;
+                    }
+                }
+            }
+        }
+        match sharp {
+            0 => VertexKind::Interior { faces: quads.len() },
+            2 => VertexKind::Boundary { faces: quads.len() },
+            _ => VertexKind::Incomplete,
+        }
+    }
+
+    /// One Catmull–Clark step. Returns the fine mesh; quad `q` of `self` has children
+    /// `4q..4q+4` ordered `[u low v low, u high v low, u high v high, u low v high]`, each with
+    /// its first corner at its own `(0, 0)` in the parent's frame.
+    pub fn subdivide(&self) -> LocalMesh {
+        let adj = Adjacency::new(self);
+        let nv = self.pts.len();
+        // Edges, numbered in first-seen order.
+        let mut edge_id: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        for q in &self.quads {
+            for k in 0..4 {
+                let key = edge_key(q[k], q[(k + 1) % 4]);
+                edge_id.entry(key).or_insert_with(|| {
+                    edges.push(key);
+                    (edges.len() - 1) as u32
+                });
+            }
+        }
+        let ne = edges.len();
+        let face_pts: Vec<Vector4> = self
+            .quads
+            .iter()
+            .map(|q| q.iter().map(|&i| self.pts[i as usize]).sum::<Vector4>() * 0.25)
+            .collect();
+        let mut pts = Vec::with_capacity(nv + ne + self.quads.len());
+        // Vertex points.
+        for v in 0..nv as u32 {
+            let p = self.pts[v as usize];
+            let new = match self.vertex_kind(&adj, v) {
+                VertexKind::Interior { faces } => {
+                    let n = faces as f64;
+                    let quads = &adj.vertex_quads[v as usize];
+                    let q: Vector4 =
+                        quads.iter().map(|&f| face_pts[f as usize]).sum::<Vector4>() / n;
+                    let mut r = Vector4::zeros();
+                    for &f in quads {
+                        let quad = &self.quads[f as usize];
+                        let k = quad.iter().position(|&x| x == v).unwrap();
+                        // Each edge is shared by two of the quads: count the outgoing one.
+                        r += (p + self.pts[quad[(k + 1) % 4] as usize]) * 0.5;
+                    }
+                    r /= n;
+                    (q + r * 2.0 + p * (n - 3.0)) / n
+                }
+                VertexKind::Boundary { faces: 1 } => p,
+                VertexKind::Boundary { .. } => {
+                    let mut nb = Vector4::zeros();
+                    for &f in &adj.vertex_quads[v as usize] {
+                        let quad = &self.quads[f as usize];
+                        let k = quad.iter().position(|&x| x == v).unwrap();
+                        for w in [quad[(k + 1) % 4], quad[(k + 3) % 4]] {
+                            if adj.is_open(v, w) {
+                                nb += self.pts[w as usize];
+                            }
+                        }
+                    }
+                    (nb + p * 6.0) / 8.0
+                }
+                VertexKind::Incomplete => p,
+            };
+            pts.push(new);
+        }
+        // Edge points.
+        for &(a, b) in &edges {
+            let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
+            let fa = adj.directed.get(&(a, b));
+            let fb = adj.directed.get(&(b, a));
+            let e = match (fa, fb) {
+                (Some(&(q0, _)), Some(&(q1, _))) => {
+                    (pa + pb + face_pts[q0 as usize] + face_pts[q1 as usize]) * 0.25
+                }
+                _ => (pa + pb) * 0.5,
+            };
+            pts.push(e);
+        }
+        pts.extend(face_pts.iter().copied());
+        let ev = |a: u32, b: u32| nv as u32 + edge_id[&edge_key(a, b)];
+        let mut quads = Vec::with_capacity(self.quads.len() * 4);
+        for (qi, q) in self.quads.iter().enumerate() {
+            let f = (nv + ne + qi) as u32;
+            let [c0, c1, c2, c3] = *q;
+            let (e01, e12, e23, e30) = (ev(c0, c1), ev(c1, c2), ev(c2, c3), ev(c3, c0));
+            quads.push([c0, e01, f, e30]);
+            quads.push([e01, c1, e12, f]);
+            quads.push([f, e12, c2, e23]);
+            quads.push([e30, f, e23, c3]);
+        }
+        let mut sharp = std::collections::HashSet::new();
+        for &(a, b) in &self.sharp {
+            if let Some(&id) = edge_id.get(&(a, b)) {
+                let e = nv as u32 + id;
+                sharp.insert(edge_key(a, e));
+                sharp.insert(edge_key(e, b));
+            }
+        }
+        LocalMesh {
+            pts,
+            origin: self.origin,
+            quads,
+            sharp,
+        }
+    }
+
+    /// The same mesh with coordinates measured from `origin + shift` (mm).
+    fn recentred(mut self, shift: Vector3) -> LocalMesh {
+        for p in self.pts.iter_mut() {
+            let w = p.w;
+            *p -= Vector4::new(shift.x * w, shift.y * w, shift.z * w, 0.0);
+        }
+        self.origin += shift;
+        self
+    }
+
+    /// The quads sharing a vertex with quad `q`, as a new local mesh; returns it and the
+    /// index of `q` in it.
+    pub fn one_ring(&self, q: u32) -> (LocalMesh, u32) {
+        let adj = Adjacency::new(self);
+        let mut keep: Vec<u32> = Vec::new();
+        for &v in &self.quads[q as usize] {
+            for &f in &adj.vertex_quads[v as usize] {
+                if !keep.contains(&f) {
+                    keep.push(f);
+                }
+            }
+        }
+        keep.sort_unstable();
+        let mut map: HashMap<u32, u32> = HashMap::new();
+        let mut pts = Vec::new();
+        let mut quads = Vec::with_capacity(keep.len());
+        for &f in &keep {
+            let quad = self.quads[f as usize];
+            quads.push(quad.map(|v| {
+                *map.entry(v).or_insert_with(|| {
+                    pts.push(self.pts[v as usize]);
+                    (pts.len() - 1) as u32
+                })
+            }));
+        }
+        let sharp = self
+            .sharp
+            .iter()
+            .filter_map(|&(a, b)| Some(edge_key(*map.get(&a)?, *map.get(&b)?)))
+            .collect();
+        let idx = keep.binary_search(&q).expect("q is in its own one-ring") as u32;
+        (
+            LocalMesh {
+                pts,
+                origin: self.origin,
+                quads,
+                sharp,
+            },
+            idx,
+        )
+    }
+
+    /// The 16 control points of quad `q` as a uniform bicubic B-spline patch, indexed
+    /// `[j][i]` with `i` along the quad's first side; `None` unless the quad is regular.
+    pub fn regular_grid(&self, q: u32) -> Option<[[Vector4; 4]; 4]> {
+        let adj = Adjacency::new(self);
+        self.regular_grid_with(&adj, q)
+    }
+
+    fn regular_grid_with(&self, adj: &Adjacency, q: u32) -> Option<[[Vector4; 4]; 4]> {
+        let quad = self.quads[q as usize];
+        for &c in &quad {
+            match self.vertex_kind(adj, c) {
+                VertexKind::Interior { faces: 4 } | VertexKind::Boundary { faces: 1 | 2 } => {}
+                _ => return None,
+            }
+        }
+        let mut g: [[Option<Vector4>; 4]; 4] = [[None; 4]; 4];
+        // Corner k sits at grid (i, j); its outer quadrant points (a, diag, b).
+        const CORNER: [(usize, usize); 4] = [(1, 1), (2, 1), (2, 2), (1, 2)];
+        const OUTER: [[(usize, usize); 3]; 4] = [
+            [(0, 1), (0, 0), (1, 0)],
+            [(2, 0), (3, 0), (3, 1)],
+            [(3, 2), (3, 3), (2, 3)],
+            [(1, 3), (0, 3), (0, 2)],
+        ];
+        let at = |quad: u32, k: i32| -> u32 { self.quads[quad as usize][k.rem_euclid(4) as usize] };
+        for k in 0..4 {
+            let p = quad[k];
+            let prev = quad[(k + 3) % 4];
+            let next = quad[(k + 1) % 4];
+            let (ci, cj) = CORNER[k];
+            g[cj][ci] = Some(self.pts[p as usize]);
+            let mut found: [Option<u32>; 3] = [None; 3];
+            // Counter-clockwise: the quad across the previous side, then the diagonal one.
+            if let Some(&(l, i)) = adj.directed.get(&(p, prev)) {
+                let a = at(l, i as i32 - 1);
+                found[0] = Some(a);
+                if let Some(&(d, j)) = adj.directed.get(&(p, a)) {
+                    found[1] = Some(at(d, j as i32 + 2));
+                    found[2] = Some(at(d, j as i32 - 1));
+                }
+            }
+            // Clockwise: the quad across the next side, then the diagonal one.
+            if let Some(&(b_quad, i)) = adj.directed.get(&(next, p)) {
+                let b = at(b_quad, i as i32 + 2);
+                found[2] = found[2].or(Some(b));
+                if let Some(&(d, j)) = adj.directed.get(&(b, p)) {
+                    found[1] = found[1].or(Some(at(d, j as i32 + 3)));
+                    found[0] = found[0].or(Some(at(d, j as i32 + 2)));
+                }
+            }
+            for (slot, v) in OUTER[k].iter().zip(found) {
+                if let Some(v) = v {
+                    g[slot.1][slot.0] = Some(self.pts[v as usize]);
+                }
+            }
+        }
+        // Mirror across sharp sides: side 0 → row 0, side 1 → column 3, side 2 → row 3,
+        // side 3 → column 0.
+        let sharp_side = |k: usize| {
+            let (a, b) = (quad[k], quad[(k + 1) % 4]);
+            adj.is_open(a, b) && self.sharp.contains(&edge_key(a, b))
+        };
+        let sides = [sharp_side(0), sharp_side(1), sharp_side(2), sharp_side(3)];
+        for _ in 0..3 {
+            for j in 0..4 {
+                for i in 0..4 {
+                    if g[j][i].is_some() {
+                        continue;
+                    }
+                    let mirror = |a: Option<Vector4>, b: Option<Vector4>| Some(a? * 2.0 - b?);
+                    let cand = if i == 0 && sides[3] {
+                        mirror(g[j][1], g[j][2])
+                    } else if i == 3 && sides[1] {
+                        mirror(g[j][2], g[j][1])
+                    } else {
+                        None
+                    }
+                    .or_else(|| {
+                        if j == 0 && sides[0] {
+                            mirror(g[1][i], g[2][i])
+                        } else if j == 3 && sides[2] {
+                            mirror(g[2][i], g[1][i])
+                        } else {
+                            None
+                        }
+                    });
+                    g[j][i] = cand;
+                }
+            }
+        }
+        let mut out = [[Vector4::zeros(); 4]; 4];
+        for j in 0..4 {
+            for i in 0..4 {
+                out[j][i] = g[j][i]?;
+            }
+        }
+        Some(out)
+    }
+
+    /// The limit point of vertex `v` (homogeneous), whose faces must all be present.
+    pub fn limit_point(&self, v: u32) -> Vector4 {
+        let adj = Adjacency::new(self);
+        let p = self.pts[v as usize];
+        match self.vertex_kind(&adj, v) {
+            VertexKind::Interior { faces } => {
+                let n = faces as f64;
+                let mut e = Vector4::zeros();
+                let mut f = Vector4::zeros();
+                for &q in &adj.vertex_quads[v as usize] {
+                    let quad = &self.quads[q as usize];
+                    let k = quad.iter().position(|&x| x == v).unwrap();
+                    e += self.pts[quad[(k + 1) % 4] as usize];
+                    f += self.pts[quad[(k + 2) % 4] as usize];
+                }
+                (p * (n * n) + e * 4.0 + f) / (n * (n + 5.0))
+            }
+            VertexKind::Boundary { faces: 1 } => p,
+            VertexKind::Boundary { .. } => {
+                let mut nb = Vector4::zeros();
+                for &q in &adj.vertex_quads[v as usize] {
+                    let quad = &self.quads[q as usize];
+                    let k = quad.iter().position(|&x| x == v).unwrap();
+                    for w in [quad[(k + 1) % 4], quad[(k + 3) % 4]] {
+                        if adj.is_open(v, w) {
+                            nb += self.pts[w as usize];
+                        }
+                    }
+                }
+                (nb + p * 4.0) / 6.0
+            }
+            VertexKind::Incomplete => p,
+        }
+    }
+
+    /// The quadtree of quad `q`: a Bézier cell if it is regular, else its children after
+    /// one subdivision step, recursively.
+    pub fn face_tree(&self, q: u32) -> Node {
+        self.tree_at(q, 0)
+    }
+
+    fn tree_at(&self, q: u32, depth: usize) -> Node {
+        if let Some(grid) = self.regular_grid(q) {
+            return Node::Leaf {
+                patch: bspline_to_bezier(&grid),
+                origin: self.origin,
+            };
+        }
+        let (ring, qi) = self.one_ring(q);
+        // The irregular corner: the one whose vertex is not regular. Measure from its limit
+        // point so the coordinates shrink with the region.
+        let adj = Adjacency::new(&ring);
+        let quad = ring.quads[qi as usize];
+        let corner = quad
+            .iter()
+            .copied()
+            .find(|&c| {
+                !matches!(
+                    ring.vertex_kind(&adj, c),
+                    VertexKind::Interior { faces: 4 } | VertexKind::Boundary { faces: 1 | 2 }
+                )
+            })
+            .unwrap_or(quad[0]);
+        let limit = ring.limit_point(corner);
+        if depth >= MAX_DEPTH {
+            let o = ring.origin;
+            return Node::Cap(
+                limit + Vector4::new(o.x * limit.w, o.y * limit.w, o.z * limit.w, 0.0),
+            );
+        }
+        let ring = ring.recentred(limit.xyz() / limit.w);
+        let fine = ring.subdivide();
+        let base = 4 * qi;
+        // Children are stored [ll, u high, both high, v high]; the tree wants
+        // [ll, u high, v high, both high].
+        let c = |k: u32| fine.tree_at(base + k, depth + 1);
+        Node::Split(Box::new([c(0), c(1), c(3), c(2)]))
+    }
+}
+
+/// Bézier form of the uniform bicubic B-spline segment of a 4×4 grid `[j][i]`.
+pub fn bspline_to_bezier(g: &[[Vector4; 4]; 4]) -> BezierPatch {
+    // Rows of the uniform cubic B-spline → Bézier conversion.
+    const M: [[f64; 4]; 4] = [
+        [1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0, 0.0],
+        [0.0, 4.0 / 6.0, 2.0 / 6.0, 0.0],
+        [0.0, 2.0 / 6.0, 4.0 / 6.0, 0.0],
+        [0.0, 1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0],
+    ];
+    let mut rows = [[Vector4::zeros(); 4]; 4];
+    for j in 0..4 {
+        for a in 0..4 {
+            rows[j][a] = (0..4).map(|i| g[j][i] * M[a][i]).sum();
+        }
+    }
+    let mut out = BezierPatch::zero();
+    for b in 0..4 {
+        for a in 0..4 {
+            out.cp[b][a] = (0..4).map(|j| rows[j][a] * M[b][j]).sum();
+        }
+    }
+    out
+}

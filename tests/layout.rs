@@ -1,0 +1,207 @@
+//! Patch layouts: counts, coverage, rectangular charts whose evaluation matches the faces
+//! (derivatives against differences), extraordinary points at patch corners, connections.
+
+use tspath::layout::ConnectionKind;
+use tspath::model::samples::{self, SAMPLES};
+use tspath::Model;
+
+fn richardson(f: &dyn Fn(f64) -> tspath::geom::Vector3, h: f64) -> tspath::geom::Vector3 {
+    let d = |h: f64| (f(h) - f(-h)) / (2.0 * h);
+    (d(h / 2.0) * 4.0 - d(h)) / 3.0
+}
+
+#[test]
+fn samples_have_their_documented_patch_counts() {
+    for s in SAMPLES {
+        let m = samples::load_sample(s.name).unwrap();
+        assert_eq!(m.layout.len(), s.patches, "{}", s.name);
+    }
+}
+
+#[test]
+fn patches_cover_the_domain_exactly_once() {
+    for s in SAMPLES {
+        let m = samples::load_sample(s.name).unwrap();
+        let faces: f64 = m.surface.faces().iter().map(|f| f.width * f.height).sum();
+        let patches: f64 = m.layout.patches.iter().map(|p| p.width * p.height).sum();
+        assert!(
+            (faces - patches).abs() < 1e-9 * faces,
+            "{}: {faces} vs {patches}",
+            s.name
+        );
+        // Every piece of every face appears once.
+        let mut area = vec![0.0; m.surface.faces().len()];
+        for p in &m.layout.patches {
+            for piece in &p.pieces {
+                area[piece.face as usize] +=
+                    (piece.local[1] - piece.local[0]) * (piece.local[3] - piece.local[2]);
+            }
+        }
+        for (f, a) in m.surface.faces().iter().zip(&area) {
+            assert!(
+                (a - f.width * f.height).abs() < 1e-9,
+                "{}: face {} covered {a}",
+                s.name,
+                f.mesh_face
+            );
+        }
+    }
+}
+
+fn patch_fd_error(m: &Model) -> f64 {
+    let mut worst: f64 = 0.0;
+    for p in &m.layout.patches {
+        for &(u, v) in &[(0.23, 0.37), (0.61, 0.18), (0.43, 0.71), (0.09, 0.88)] {
+            let d = p.derivs(&m.surface, u, v);
+            assert!(
+                (d.point - p.subs(&m.surface, u, v)).norm() < 1e-12 * m.surface.bbox().diagonal()
+            );
+            let h = 1e-4 / p.width.max(p.height).max(1.0);
+            let fu = richardson(&|e| p.subs(&m.surface, u + e, v).coords, h);
+            let fv = richardson(&|e| p.subs(&m.surface, u, v + e).coords, h);
+            let fuu = richardson(&|e| p.derivs(&m.surface, u + e, v).su, h);
+            let fuv = richardson(&|e| p.derivs(&m.surface, u, v + e).su, h);
+            let fvv = richardson(&|e| p.derivs(&m.surface, u, v + e).sv, h);
+            let s1 = d.su.norm().max(d.sv.norm());
+            let s2 = d.suu.norm().max(d.suv.norm()).max(d.svv.norm()).max(s1);
+            worst = worst
+                .max((fu - d.su).norm() / s1)
+                .max((fv - d.sv).norm() / s1)
+                .max((fuu - d.suu).norm() / s2)
+                .max((fuv - d.suv).norm() / s2)
+                .max((fvv - d.svv).norm() / s2);
+        }
+    }
+    worst
+}
+
+#[test]
+fn patch_parameterisation_has_consistent_derivatives() {
+    for s in SAMPLES {
+        let m = samples::load_sample(s.name).unwrap();
+        let e = patch_fd_error(&m);
+        println!(
+            "{}: worst relative derivative error on patches {e:.2e}",
+            s.name
+        );
+        assert!(e < 1e-6, "{}: {e}", s.name);
+    }
+}
+
+#[test]
+fn extraordinary_points_sit_at_patch_corners() {
+    for name in ["keycap-convex", "head", "plate-hole", "bumps-hole"] {
+        let m = samples::load_sample(name).unwrap();
+        let size = m.surface.bbox().diagonal();
+        let corners: Vec<_> = m
+            .layout
+            .patches
+            .iter()
+            .flat_map(|p| {
+                [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+                    .map(|(u, v)| p.subs(&m.surface, u, v))
+            })
+            .collect();
+        let index: std::collections::HashMap<u32, usize> = m
+            .surface
+            .faces()
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.mesh_face, i))
+            .collect();
+        for v in (0..m.mesh.vertex_count() as u32).filter(|&v| m.mesh.is_extraordinary(v)) {
+            let h = m.mesh.outgoing(v)[0];
+            let e = m.mesh.he(h);
+            let (u0, v0) = match e.side {
+                0 => (0.0, 0.0),
+                1 => (1.0, 0.0),
+                2 => (1.0, 1.0),
+                _ => (0.0, 1.0),
+            };
+            let p = m.surface.subs(index[&e.face], u0, v0);
+            let n = corners
+                .iter()
+                .filter(|c| (*c - p).norm() < 1e-9 * size)
+                .count();
+            let faces = m.mesh.outgoing(v).len();
+            assert_eq!(
+                n, faces,
+                "{name}: EP {v} is a corner of {n} patches, has {faces} faces"
+            );
+        }
+    }
+}
+
+#[test]
+fn connections_of_the_box_samples() {
+    let k = samples::load_sample("keycap-convex").unwrap();
+    let boundary: Vec<_> = k
+        .layout
+        .connections
+        .iter()
+        .filter(|c| c.kind == ConnectionKind::Boundary)
+        .collect();
+    // Top to four walls, and each wall to its two neighbours.
+    assert_eq!(boundary.len(), 8);
+    assert!(k
+        .layout
+        .connections
+        .iter()
+        .all(|c| c.kind == ConnectionKind::Boundary));
+    let h = samples::load_sample("head").unwrap();
+    assert_eq!(h.layout.connections.len(), 12, "the cube's 12 edges");
+    for c in &h.layout.connections {
+        let (sa, sb) = c.sides.unwrap();
+        let pa = &h.layout.patches[c.a as usize];
+        let pb = &h.layout.patches[c.b as usize];
+        // The middle of the shared side is the same point seen from both patches.
+        let mid = |p: &tspath::layout::Patch, s: u8| {
+            let (u, v) = [(0.5, 0.0), (1.0, 0.5), (0.5, 1.0), (0.0, 0.5)][s as usize];
+            p.subs(&h.surface, u, v)
+        };
+        assert!((mid(pa, sa) - mid(pb, sb)).norm() < 1e-9);
+    }
+}
+
+#[test]
+fn valence_five_gives_corner_connections() {
+    // Five quads around an interior vertex: five patches; neighbours share a side,
+    // the others only the extraordinary point.
+    let mut s = String::from("v 0 0 0\n");
+    for k in 0..5 {
+        let a = k as f64 * std::f64::consts::TAU / 5.0;
+        let b = a + std::f64::consts::TAU / 10.0;
+        s += &format!(
+            "v {} {} 0\nv {} {} 0\n",
+            a.cos(),
+            a.sin(),
+            1.8 * b.cos(),
+            1.8 * b.sin()
+        );
+    }
+    for k in 0..5 {
+        s += &format!(
+            "f 1 {} {} {}\n",
+            2 + 2 * k,
+            3 + 2 * k,
+            2 + 2 * ((k + 1) % 5)
+        );
+    }
+    let m = tspath::io::load(s.as_bytes(), "v5").unwrap();
+    assert_eq!(m.layout.len(), 5);
+    let kinds: Vec<_> = m.layout.connections.iter().map(|c| c.kind).collect();
+    assert_eq!(
+        kinds
+            .iter()
+            .filter(|k| **k == ConnectionKind::Boundary)
+            .count(),
+        5
+    );
+    assert_eq!(
+        kinds
+            .iter()
+            .filter(|k| **k == ConnectionKind::Corner)
+            .count(),
+        5
+    );
+}

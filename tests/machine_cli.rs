@@ -1,0 +1,106 @@
+//! `tspath plan --machine/--dialect/--units` and `tspath machine`, run in-process.
+
+use tspath::cli::run;
+
+fn args(s: &[&str]) -> Vec<String> {
+    s.iter().map(|x| x.to_string()).collect()
+}
+
+#[test]
+fn plan_writes_the_chosen_machine_dialect_and_units() {
+    let dir = std::env::temp_dir().join(format!("tspath-machine-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |f: &str| dir.join(f).to_str().unwrap().to_string();
+    let list = run(&args(&["machine", "--list"])).unwrap();
+    for name in [
+        "3-axis",
+        "table-table-ac",
+        "table-table-bc",
+        "linuxcnc",
+        "fanuc",
+        "heidenhain",
+        "siemens",
+    ] {
+        assert!(list.contains(name), "--list names {name}");
+    }
+    // A built-in machine written as JSON, then used from the file: same program as by name.
+    run(&args(&["machine", "table-table-bc", "-o", &p("bc.json")])).unwrap();
+    let plan = |machine: &str, dialect: &str, units: &str, out: &str| {
+        run(&args(&[
+            "plan",
+            "dome",
+            "--tool-radius",
+            "3",
+            "--scallop",
+            "0.05",
+            "--machine",
+            machine,
+            "--dialect",
+            dialect,
+            "--units",
+            units,
+            "-o",
+            &p(out),
+            "--report",
+            &p("report.json"),
+        ]))
+        .unwrap();
+        std::fs::read_to_string(p(out)).unwrap()
+    };
+    let by_name = plan("table-table-bc", "siemens", "inch", "a.mpf");
+    let by_file = plan(&p("bc.json"), "siemens", "inch", "b.mpf");
+    assert_eq!(by_name, by_file);
+    assert!(by_name.contains("G700") && by_name.contains("TRAORI") && by_name.contains("TRAFOOF"));
+    let h = plan("table-table-ac", "heidenhain", "mm", "c.h");
+    assert!(h.starts_with("0 BEGIN PGM DOME MM\n") && h.contains("FUNCTION TCPM"));
+    assert!(h.trim_end().ends_with("END PGM DOME MM"));
+    // Defaults: 3-axis, linuxcnc, mm.
+    run(&args(&[
+        "plan",
+        "dome",
+        "--tool-radius",
+        "3",
+        "--scallop",
+        "0.05",
+        "-o",
+        &p("d.ngc"),
+    ]))
+    .unwrap();
+    let d = std::fs::read_to_string(p("d.ngc")).unwrap();
+    assert!(d.contains("G21 G90") && d.contains("machine: 3-axis, dialect: linuxcnc"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn machine_and_dialect_errors_are_actionable() {
+    let e = run(&args(&["plan", "dome", "--dialect", "mazak"]))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("mazak") && e.contains("linuxcnc") && e.contains("heidenhain"),
+        "{e}"
+    );
+    let e = run(&args(&["plan", "dome", "--machine", "no-such-machine"]))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no-such-machine") && e.contains("table-table-ac"),
+        "{e}"
+    );
+    let e = run(&args(&["plan", "dome", "--units", "furlong"]))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("furlong") && e.contains("inch"), "{e}");
+    let dir = std::env::temp_dir().join(format!("tspath-machine-cli-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("m.json");
+    std::fs::write(&f, r#"{"format": "tspath-machine", "version": 1, "name": "x", "rotaries": [{"name": "A", "mount": "table", "axis": [1, 0, 0], "direction": 3}, {"name": "C", "mount": "table", "axis": [0, 0, 1]}]}"#).unwrap();
+    let e = run(&args(&["plan", "dome", "--machine", f.to_str().unwrap()]))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("m.json") && e.contains("rotaries[0].direction"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
