@@ -29,7 +29,7 @@ fn bench(c: &mut Criterion) {
         let plan = isoparametric::plan_zigzag(&model, &opts, &mut |_| true).expect("plans");
         let path = CutterPath::from_toolpath(&plan).expect("valid path");
         let vopts = VerifyOptions::default()
-            .with_samples(100_000)
+            .with_samples(300_000)
             .with_scallop(h)
             .with_gouge_tolerance(opts.chordal_mm);
         let found = verify::verify_to_bound(&model.surface, &path, &vopts, bound).expect("runs");

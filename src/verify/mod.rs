@@ -229,7 +229,10 @@ pub fn verify(surface: &Surface, path: &CutterPath, opts: &VerifyOptions) -> Res
 }
 
 /// Most rounds of [`verify_to_bound`].
-const BOUND_ROUNDS: usize = 4;
+const BOUND_ROUNDS: usize = 6;
+/// Most growth of the sample count in one round: far from the asymptotic regime (cells
+/// whose bound is capped) the bound's excess overstates the samples needed.
+const BOUND_MAX_GROWTH: f64 = 4.0;
 /// Extra samples asked for beyond what the bound's fall with the spacing squared predicts.
 const BOUND_SAFETY: f64 = 1.1;
 
@@ -255,7 +258,7 @@ pub fn verify_to_bound(
         if v.error_bound_mm <= target_mm || o.samples >= MAX_SAMPLES {
             break;
         }
-        let grow = (v.error_bound_mm / target_mm * BOUND_SAFETY).max(1.5);
+        let grow = (v.error_bound_mm / target_mm * BOUND_SAFETY).clamp(1.5, BOUND_MAX_GROWTH);
         o.samples = ((o.samples as f64 * grow).ceil() as usize).min(MAX_SAMPLES);
         v = verify(surface, path, &o)?;
     }
