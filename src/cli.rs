@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions};
+use crate::verify::{self, CutterPath, VerifyOptions};
 use std::time::Instant;
 
 const USAGE: &str = "usage:
@@ -16,13 +17,18 @@ const USAGE: &str = "usage:
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
-              [-o OUT.nc] [--report REPORT.json]
+              [-o OUT.nc] [--report REPORT.json] [--verify [--verify-samples N]]
   tspath machine --list
   tspath machine NAME [-o FILE.json]
+  tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
+              [--scallop MM] [--gouge-tolerance MM] [--machine NAME|FILE.json] [--dialect NAME]
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
 --machine is a built-in machine (default 3-axis) or a machine JSON file (start from
 `tspath machine NAME -o FILE.json`); --dialect is linuxcnc (default), linuxcnc-tcp, fanuc,
 heidenhain, siemens or plain; --units mm (default) or inch.
+verify simulates the ball-end cut of a program (read for --machine and --dialect) or of a
+tspath-cl JSON tool path and prints the scallops and gouges it leaves as JSON; --bound
+raises the sample count until the stated error bound is within MM.
 ";
 
 /// Runs one command; returns what it prints on success.
@@ -35,6 +41,7 @@ pub fn run(args: &[String]) -> Result<String> {
         "info" => info(rest),
         "sample" => sample(rest),
         "plan" => plan(rest),
+        "verify" => verify_cmd(rest),
         "export" => export(rest),
         "machine" => machine_cmd(rest),
         "-h" | "--help" | "help" => Ok(USAGE.into()),
@@ -102,6 +109,15 @@ impl Args<'_> {
     }
     fn has(&self, flag: &str) -> bool {
         self.flags.iter().any(|(f, _)| *f == flag)
+    }
+    fn count(&self, flag: &'static str) -> Result<Option<usize>> {
+        match self.value(flag) {
+            None => Ok(None),
+            Some(v) => v
+                .parse::<usize>()
+                .map(Some)
+                .map_err(|_| Error::Io(format!("{flag}: `{v}` is not a whole number"))),
+        }
     }
     fn number(&self, flag: &'static str) -> Result<Option<f64>> {
         match self.value(flag) {
@@ -196,6 +212,7 @@ fn plan(args: &[String]) -> Result<String> {
             "--feed",
             "-o",
             "--report",
+            "--verify-samples",
             "--machine",
             "--dialect",
             "--units",
@@ -209,7 +226,7 @@ fn plan(args: &[String]) -> Result<String> {
             "--holder-length",
             "--max-tilt",
         ],
-        &[],
+        &["--verify"],
     )?;
     let [model] = a.positional[..] else {
         return Err(Error::Io(format!("plan takes one MODEL\n{USAGE}")));
@@ -287,7 +304,19 @@ fn plan(args: &[String]) -> Result<String> {
         dialect,
         units,
     )?;
-    let report_json = serde_json::to_string_pretty(&report).expect("report serialises") + "\n";
+    let mut report_value = serde_json::to_value(&report).expect("report serialises");
+    if a.has("--verify") {
+        let mut vopts = VerifyOptions::default()
+            .with_scallop(opts.scallop_mm)
+            .with_gouge_tolerance(opts.chordal_mm);
+        if let Some(n) = a.count("--verify-samples")? {
+            vopts = vopts.with_samples(n);
+        }
+        let v = verify::verify(&m.surface, &CutterPath::from_toolpath(&path)?, &vopts)?;
+        report_value["verify"] = serde_json::to_value(&v).expect("verification serialises");
+    }
+    let report_json =
+        serde_json::to_string_pretty(&report_value).expect("report serialises") + "\n";
     let mut out = String::new();
     match a.value("-o") {
         Some(p) => write_file(p, &gcode)?,
@@ -299,6 +328,68 @@ fn plan(args: &[String]) -> Result<String> {
         None => {}
     }
     Ok(out)
+}
+
+fn verify_cmd(args: &[String]) -> Result<String> {
+    let a = parse(
+        args,
+        &[
+            "--tool-radius",
+            "--samples",
+            "--bound",
+            "--scallop",
+            "--gouge-tolerance",
+            "--machine",
+            "--dialect",
+        ],
+        &[],
+    )?;
+    let [model, path_file] = a.positional[..] else {
+        return Err(Error::Io(format!(
+            "verify takes a MODEL and a G-code or tool path file\n{USAGE}"
+        )));
+    };
+    let Some(r) = a.number("--tool-radius")? else {
+        return Err(Error::Io(format!(
+            "verify needs --tool-radius MM (the ball-end radius)\n{USAGE}"
+        )));
+    };
+    let m = load_model(model)?;
+    let text = std::fs::read_to_string(path_file)
+        .map_err(|e| Error::Io(format!("cannot read {path_file}: {e}")))?;
+    let (path, mut opts) = if text.trim_start().starts_with('{') {
+        (
+            CutterPath::from_cl_json(&text, r)?,
+            VerifyOptions::default(),
+        )
+    } else {
+        let mach = load_machine(a.value("--machine").unwrap_or("3-axis"))?;
+        let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
+        let (path, header) =
+            verify::gcode::read_program(&text, r, &mach, dialect).map_err(|e| match e {
+                Error::InvalidParameter { name, message } => Error::InvalidParameter {
+                    name,
+                    message: format!("{path_file}: {message}"),
+                },
+                other => other,
+            })?;
+        // The tolerances the program was made for, unless given.
+        (path, header.options())
+    };
+    if let Some(h) = a.number("--scallop")? {
+        opts.scallop_mm = h;
+    }
+    if let Some(t) = a.number("--gouge-tolerance")? {
+        opts.gouge_tolerance_mm = t;
+    }
+    if let Some(n) = a.count("--samples")? {
+        opts.samples = n;
+    }
+    let v = match a.number("--bound")? {
+        Some(b) => verify::verify_to_bound(&m.surface, &path, &opts, b)?,
+        None => verify::verify(&m.surface, &path, &opts)?,
+    };
+    Ok(serde_json::to_string_pretty(&v).expect("verification serialises") + "\n")
 }
 
 /// A built-in machine by name, or a machine JSON file.

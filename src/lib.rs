@@ -25,6 +25,7 @@ pub mod model;
 pub mod plan;
 pub mod surface;
 pub mod tmesh;
+pub mod verify;
 pub mod wasm;
 
 pub use error::{Error, Result};

@@ -10,6 +10,7 @@ use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions, PlanReport, Toolpath};
 use crate::surface::tessellate::Tessellation;
+use crate::verify::{self, CutterPath, Verification, VerifyOptions};
 use wasm_bindgen::prelude::*;
 
 fn js_err(e: Error) -> JsError {
@@ -322,5 +323,119 @@ impl WasmPlan {
         let d = Dialect::parse(dialect).map_err(js_err)?;
         let u = Units::parse(units).map_err(js_err)?;
         machine::post(&self.path, &self.opts, &self.job, &m, d, u).map_err(js_err)
+    }
+}
+
+/// Verification options from a JavaScript object over `base`: any fields of
+/// [`VerifyOptions`] given replace those of `base`.
+fn verify_options(base: VerifyOptions, options: JsValue) -> Result<VerifyOptions, JsError> {
+    if options.is_undefined() || options.is_null() {
+        return Ok(base);
+    }
+    let given: serde_json::Value = serde_wasm_bindgen::from_value(options)
+        .map_err(|e| JsError::new(&format!("invalid verify options: {e}")))?;
+    let mut merged = serde_json::to_value(&base).expect("options serialise");
+    match (given, &mut merged) {
+        (serde_json::Value::Object(g), serde_json::Value::Object(m)) => {
+            for (k, v) in g {
+                m.insert(k, v);
+            }
+        }
+        _ => return Err(JsError::new("invalid verify options: expected an object")),
+    }
+    serde_json::from_value(merged)
+        .map_err(|e| JsError::new(&format!("invalid verify options: {e}")))
+}
+
+#[wasm_bindgen(js_class = Model)]
+impl WasmModel {
+    /// Simulates the ball-end cut of `plan` on this model and measures scallops and gouges.
+    /// `mesh` is the tessellation the page shows (from `tessellate`): the heat map has one
+    /// value per vertex of it. `options` is a plain object with any of `samples`,
+    /// `scallop_mm`, `gouge_tolerance_mm`, `tool_side` (`"auto"`, `"normal"`, `"opposite"`);
+    /// the scallop and gouge tolerance default to the plan's scallop and chordal tolerance.
+    pub fn verify(
+        &self,
+        plan: &WasmPlan,
+        mesh: &WasmMesh,
+        options: JsValue,
+    ) -> Result<WasmVerification, JsError> {
+        let base = VerifyOptions::default()
+            .with_scallop(plan.opts.scallop_mm)
+            .with_gouge_tolerance(plan.opts.chordal_mm);
+        let opts = verify_options(base, options)?;
+        let path = CutterPath::from_toolpath(&plan.path).map_err(js_err)?;
+        let t0 = now_ms();
+        let (summary, heat) =
+            verify::verify_with_heat_map(&self.model.surface, &path, &opts, &mesh.mesh)
+                .map_err(js_err)?;
+        Ok(WasmVerification {
+            summary,
+            heat,
+            verify_ms: now_ms() - t0,
+        })
+    }
+
+    /// As `verify`, for a program (any dialect the project writes, for `machine`, a
+    /// built-in name or machine JSON, and `dialect`, as for `gcodeFor`) cut with a ball-end
+    /// of radius `tool_radius_mm` (mm). The scallop and gouge tolerance default to those in
+    /// the program's header.
+    #[wasm_bindgen(js_name = verifyGcode)]
+    pub fn verify_gcode(
+        &self,
+        gcode: &str,
+        tool_radius_mm: f64,
+        machine: &str,
+        dialect: &str,
+        mesh: &WasmMesh,
+        options: JsValue,
+    ) -> Result<WasmVerification, JsError> {
+        let m = machine::resolve(machine).map_err(js_err)?;
+        let d = Dialect::parse(dialect).map_err(js_err)?;
+        let (path, header) =
+            verify::gcode::read_program(gcode, tool_radius_mm, &m, d).map_err(js_err)?;
+        let opts = verify_options(header.options(), options)?;
+        let t0 = now_ms();
+        let (summary, heat) =
+            verify::verify_with_heat_map(&self.model.surface, &path, &opts, &mesh.mesh)
+                .map_err(js_err)?;
+        Ok(WasmVerification {
+            summary,
+            heat,
+            verify_ms: now_ms() - t0,
+        })
+    }
+}
+
+/// The result of a verification: its summary and the heat map.
+#[wasm_bindgen(js_name = Verification)]
+pub struct WasmVerification {
+    summary: Verification,
+    heat: Vec<f32>,
+    verify_ms: f64,
+}
+
+#[wasm_bindgen(js_class = Verification)]
+impl WasmVerification {
+    /// `{max_scallop_mm, mean_scallop_mm, p95_scallop_mm, uncut_fraction,
+    /// unreached_fraction, max_gouge_mm, gouge_count, error_bound_mm, samples, ...,
+    /// patches: [...]}` (all lengths in mm), as `tspath verify` prints it.
+    pub fn summary(&self) -> Result<JsValue, JsError> {
+        serde_wasm_bindgen::to_value(&self.summary).map_err(|e| JsError::new(&e.to_string()))
+    }
+
+    /// One value per vertex of the mesh passed to `verify`: the deepest gouge as a negative
+    /// number (mm) where the cut went below the surface by more than the gouge tolerance,
+    /// else the most material left (mm); `Infinity` where the tool never came within one
+    /// radius.
+    #[wasm_bindgen(js_name = heatMap)]
+    pub fn heat_map(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(&self.heat[..])
+    }
+
+    /// Wall time of the simulation (ms).
+    #[wasm_bindgen(getter, js_name = verifyMs)]
+    pub fn verify_ms(&self) -> f64 {
+        self.verify_ms
     }
 }

@@ -1,0 +1,693 @@
+//! The simulation proper: sample grids per patch, measurements in bands of rows (in
+//! parallel natively, in a fixed order so that results do not depend on the thread count),
+//! cell bounds, and the summary.
+
+use super::bound::{cell_bound, second_derivative_bound, CellFrame, Corner};
+use super::capsule::Capsule;
+use super::heatmap::{worse, HeatMap};
+use super::index::CapsuleIndex;
+use super::probe::{Material, Probe};
+use super::stats::weighted_quantile;
+use super::{CutterPath, PatchVerification, ToolSide, Verification, VerifyOptions};
+use crate::geom::{Aabb, Point3, Vector3};
+use crate::surface::{DiffGeom, FaceSurface, Surface, SurfaceDerivs};
+
+/// Samples per side used to estimate a patch's area and side lengths.
+const AREA_PROBE: usize = 17;
+/// Samples per side of each patch used to tell which side the tool is on.
+const SIDE_PROBE: usize = 16;
+/// Margin of the indexed region beyond the surface's box, as a fraction of its diagonal.
+const REGION_MARGIN: f64 = 0.02;
+/// Edge of an index cell in tool radii.
+const CELL_PER_RADIUS: f64 = 0.5;
+/// Where the surface has no normal, it is taken this far (in parameter) towards the middle.
+const SINGULAR_NUDGE: f64 = 1e-3;
+/// Entry cosine below which a line only grazes a ball (its slope is unbounded there).
+const GRAZING_COS: f64 = 1e-9;
+/// Sample rows per band of work.
+const BAND_ROWS: usize = 32;
+/// Probability mass of the reported percentile.
+const PERCENTILE: f64 = 0.95;
+/// Newton steps towards the bottom of the deepest gouge of a band.
+const GOUGE_NEWTON_STEPS: usize = 6;
+/// Largest Newton step, in cells.
+const GOUGE_STEP_CELLS: f64 = 2.0;
+
+/// How one patch is sampled.
+#[derive(Debug, Clone, Copy)]
+struct FaceGrid {
+    nu: usize,
+    nv: usize,
+}
+
+/// One measured sample.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    corner: Corner,
+    /// Unit normal `S_u × S_v` (zero where there is none).
+    normal: Vector3,
+    singular: bool,
+    /// `|S_u × S_v|` (mm² per unit parameter²).
+    area_density: f64,
+}
+
+/// Running totals of one band or patch.
+#[derive(Debug, Clone, Default)]
+struct Acc {
+    samples: usize,
+    singular: usize,
+    unreached: usize,
+    gouges: usize,
+    gouge_area: f64,
+    area: f64,
+    unreached_area: f64,
+    uncut_area: f64,
+    reached_area: f64,
+    scallop_area: f64,
+    max_left: Option<f64>,
+    max_gouge: f64,
+    upper: Option<f64>,
+    /// Extra measurements at located cusps.
+    refined: usize,
+    /// Upper bound of the deepest gouge over the cells (mm).
+    gouge_upper: Option<f64>,
+    spacing: f64,
+    /// (scallop, area weight) of every reached sample, one chunk per band.
+    values: Vec<Vec<(f64, f64)>>,
+}
+
+impl Acc {
+    fn merge(&mut self, o: Acc) {
+        self.samples += o.samples;
+        self.singular += o.singular;
+        self.unreached += o.unreached;
+        self.gouges += o.gouges;
+        self.gouge_area += o.gouge_area;
+        self.area += o.area;
+        self.unreached_area += o.unreached_area;
+        self.uncut_area += o.uncut_area;
+        self.reached_area += o.reached_area;
+        self.scallop_area += o.scallop_area;
+        self.max_left = max_opt(self.max_left, o.max_left);
+        self.max_gouge = self.max_gouge.max(o.max_gouge);
+        self.upper = max_opt(self.upper, o.upper);
+        self.refined += o.refined;
+        self.gouge_upper = max_opt(self.gouge_upper, o.gouge_upper);
+        self.spacing = self.spacing.max(o.spacing);
+        self.values.extend(o.values);
+    }
+}
+
+fn max_opt(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.max(y)),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}
+
+/// Everything a band needs, shared read-only.
+struct Ctx<'a> {
+    surface: &'a Surface,
+    capsules: &'a [Capsule],
+    index: &'a CapsuleIndex,
+    grids: &'a [FaceGrid],
+    radius: f64,
+    reach: f64,
+    max_depth: f64,
+    sigma: f64,
+    opts: &'a VerifyOptions,
+}
+
+fn face_size(face: &FaceSurface) -> (f64, f64, f64) {
+    let n = AREA_PROBE;
+    let h = 1.0 / n as f64;
+    let mut area = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let d = face.derivs((i as f64 + 0.5) * h, (j as f64 + 0.5) * h);
+            area += d.su.cross(&d.sv).norm() * h * h;
+        }
+    }
+    let (mut lu, mut lv) = (0.0, 0.0);
+    for a in 0..n {
+        let x = (a as f64 + 0.5) * h;
+        for b in 0..n {
+            let (y0, y1) = (b as f64 * h, (b + 1) as f64 * h);
+            lu += (face.subs(y1, x) - face.subs(y0, x)).norm();
+            lv += (face.subs(x, y1) - face.subs(x, y0)).norm();
+        }
+    }
+    (area, lu / n as f64, lv / n as f64)
+}
+
+fn grids(surface: &Surface, samples: usize) -> Vec<FaceGrid> {
+    let sizes: Vec<(f64, f64, f64)> = surface.faces().iter().map(face_size).collect();
+    let total: f64 = sizes.iter().map(|s| s.0).sum();
+    sizes
+        .iter()
+        .map(|&(area, lu, lv)| {
+            let share = if total > 0.0 {
+                samples as f64 * area / total
+            } else {
+                samples as f64 / sizes.len() as f64
+            };
+            let aspect = if lu > 0.0 && lv > 0.0 { lu / lv } else { 1.0 };
+            // At least 2 × 2, and no more than its share even for a sliver of a patch.
+            let most = (0.5 * share).max(2.0);
+            let nu = (share * aspect).sqrt().round().clamp(2.0, most) as usize;
+            let nv = (share / nu as f64).round().clamp(2.0, most) as usize;
+            FaceGrid { nu, nv }
+        })
+        .collect()
+}
+
+/// Derivatives with a usable normal: at `(u, v)`, else nudged towards the middle.
+fn geometry(face: &FaceSurface, u: f64, v: f64) -> Option<(SurfaceDerivs, DiffGeom)> {
+    let d = face.derivs(u, v);
+    if let Some(g) = DiffGeom::try_from_derivs(&d) {
+        return Some((d, g));
+    }
+    let (uu, vv) = (
+        0.5 + (u - 0.5) * (1.0 - SINGULAR_NUDGE),
+        0.5 + (v - 0.5) * (1.0 - SINGULAR_NUDGE),
+    );
+    let d2 = face.derivs(uu, vv);
+    DiffGeom::try_from_derivs(&d2).map(|g| {
+        (
+            SurfaceDerivs {
+                point: d.point,
+                ..d2
+            },
+            g,
+        )
+    })
+}
+
+fn measure(ctx: &Ctx, probe: &mut Probe, face: &FaceSurface, u: f64, v: f64) -> Sample {
+    let unmeasured = |point: Point3, singular: bool, area_density: f64| Sample {
+        corner: Corner {
+            point,
+            reached: false,
+            left_mm: f64::INFINITY,
+            grad: [0.0; 2],
+            w_mm: 0.0,
+            slope: 0.0,
+            kappa_convex: 0.0,
+            metric: [0.0; 3],
+            second: [0.0; 3],
+        },
+        normal: Vector3::zeros(),
+        singular,
+        area_density,
+    };
+    let Some((d, g)) = geometry(face, u, v) else {
+        return unmeasured(face.subs(u, v), true, 0.0);
+    };
+    let area_density = d.su.cross(&d.sv).norm();
+    let n = g.normal * ctx.sigma;
+    let Material::Left { left_mm, governing } = probe.measure(&d.point, &n) else {
+        return unmeasured(d.point, false, area_density);
+    };
+    // Weingarten: derivatives of the unit normal S_u × S_v, then to the tool side.
+    let det = g.metric_det();
+    let nu = (d.su * (g.m * g.f - g.l * g.g) + d.sv * (g.l * g.f - g.m * g.e)) / det * ctx.sigma;
+    let nv = (d.su * (g.n * g.f - g.m * g.g) + d.sv * (g.m * g.f - g.n * g.e)) / det * ctx.sigma;
+    let m = governing.hit.normal_in;
+    let mn = m.dot(&n);
+    let t = left_mm;
+    let (grad, w_mm) = if mn < -GRAZING_COS {
+        (
+            [-m.dot(&(d.su + nu * t)) / mn, -m.dot(&(d.sv + nv * t)) / mn],
+            -ctx.radius * mn,
+        )
+    } else {
+        ([f64::INFINITY; 2], 0.0)
+    };
+    let slope = if w_mm > 0.0 {
+        ((g.g * grad[0] * grad[0] - 2.0 * g.f * grad[0] * grad[1] + g.e * grad[1] * grad[1]) / det)
+            .max(0.0)
+            .sqrt()
+    } else {
+        f64::INFINITY
+    };
+    let (k_lo, k_hi) = g.principal();
+    let k_min_tool_side = if ctx.sigma > 0.0 { k_lo } else { -k_hi };
+    Sample {
+        corner: Corner {
+            point: d.point,
+            reached: true,
+            left_mm,
+            grad,
+            w_mm,
+            slope,
+            kappa_convex: (-k_min_tool_side).max(0.0),
+            metric: [g.e, g.f, g.g],
+            second: [d.suu.norm(), d.suv.norm(), d.svv.norm()],
+        },
+        normal: g.normal,
+        singular: false,
+        area_density,
+    }
+}
+
+/// The heat value of a sample: gouge depth (negative) beyond the tolerance, else material
+/// left, `+∞` if unreached, NaN if unmeasured.
+fn heat_value(s: &Sample, tol: f64) -> f32 {
+    if s.singular {
+        f32::NAN
+    } else if !s.corner.reached {
+        f32::INFINITY
+    } else if -s.corner.left_mm > tol {
+        s.corner.left_mm as f32
+    } else {
+        s.corner.left_mm.max(0.0) as f32
+    }
+}
+
+/// Measures rows `j0..=j1` of face `fi` and the cells between them; row `j0` is counted
+/// only if `own_first`.
+fn band(
+    ctx: &Ctx,
+    probe: &mut Probe,
+    fi: usize,
+    j0: usize,
+    j1: usize,
+    own_first: bool,
+    mut heat: Option<&mut HeatMap>,
+) -> Acc {
+    let face = &ctx.surface.faces()[fi];
+    let FaceGrid { nu, nv } = ctx.grids[fi];
+    let (du, dv) = (1.0 / (nu - 1) as f64, 1.0 / (nv - 1) as f64);
+    let r = ctx.radius;
+    let tol = ctx.opts.gouge_tolerance_mm;
+    let h_req = ctx.opts.scallop_mm;
+    let mut acc = Acc::default();
+    let mut deepest: Option<(f64, f64, f64)> = None;
+    let mut values: Vec<(f64, f64)> = Vec::new();
+    let mut prev: Vec<Sample> = Vec::new();
+    let mut row: Vec<Sample> = Vec::with_capacity(nu);
+    // Grid coordinates by division, so that the last row and column are exactly 1.
+    let at = |k: usize, n: usize| k as f64 / (n - 1) as f64;
+    for j in j0..=j1 {
+        let v = at(j, nv);
+        row.clear();
+        for i in 0..nu {
+            row.push(measure(ctx, probe, face, at(i, nu), v));
+        }
+        if j > j0 || own_first {
+            let wv = if j == 0 || j == nv - 1 { 0.5 } else { 1.0 };
+            for (i, s) in row.iter().enumerate() {
+                let wu = if i == 0 || i == nu - 1 { 0.5 } else { 1.0 };
+                let w = s.area_density * du * dv * wu * wv;
+                acc.samples += 1;
+                acc.area += w;
+                if let Some(h) = heat.as_deref_mut() {
+                    h.add(&s.corner.point, &s.normal, heat_value(s, tol));
+                }
+                if s.singular {
+                    acc.singular += 1;
+                    continue;
+                }
+                if !s.corner.reached {
+                    acc.unreached += 1;
+                    acc.unreached_area += w;
+                    acc.uncut_area += w;
+                    continue;
+                }
+                let left = s.corner.left_mm;
+                acc.reached_area += w;
+                acc.max_left = max_opt(acc.max_left, Some(left));
+                if left > h_req {
+                    acc.uncut_area += w;
+                }
+                if -left > tol {
+                    acc.gouges += 1;
+                    acc.gouge_area += w;
+                }
+                acc.max_gouge = acc.max_gouge.max(-left);
+                if left < 0.0 && deepest.is_none_or(|(d, ..)| left < d) {
+                    deepest = Some((left, at(i, nu), v));
+                }
+                let scallop = left.max(0.0);
+                acc.scallop_area += scallop * w;
+                values.push((scallop, w));
+            }
+        }
+        if j > j0 {
+            for i in 0..nu - 1 {
+                let c = [
+                    &prev[i].corner,
+                    &prev[i + 1].corner,
+                    &row[i].corner,
+                    &row[i + 1].corner,
+                ];
+                acc.spacing = acc.spacing.max(
+                    (c[0].point - c[3].point)
+                        .norm()
+                        .max((c[1].point - c[2].point).norm()),
+                );
+                if c.iter().any(|c| !c.reached) {
+                    continue;
+                }
+                let best = [
+                    acc.upper.unwrap_or(f64::NEG_INFINITY),
+                    acc.gouge_upper.unwrap_or(f64::NEG_INFINITY),
+                ];
+                let frame = CellFrame {
+                    du,
+                    dv,
+                    boundary: [j == 1, i + 2 == nu, j + 1 == nv, i == 0],
+                };
+                let b = cell_bound(&c, &frame, r, ctx.reach, best);
+                acc.upper = max_opt(acc.upper, Some(b.scallop_upper_mm));
+                // Measure at the cusp the bound located, where it could raise the maximum.
+                if let Some([x, y]) = b.argmax {
+                    if acc.max_left.is_none_or(|m| b.scallop_upper_mm > m) {
+                        let (u, v) = ((at(i, nu) + x).min(1.0), (at(j - 1, nv) + y).min(1.0));
+                        let s = measure(ctx, probe, face, u, v);
+                        if s.corner.reached {
+                            acc.max_left = max_opt(acc.max_left, Some(s.corner.left_mm));
+                            acc.refined += 1;
+                        }
+                    }
+                }
+                acc.gouge_upper = max_opt(acc.gouge_upper, Some(b.gouge_upper_mm));
+            }
+        }
+        std::mem::swap(&mut prev, &mut row);
+    }
+    acc.values.push(values);
+    if let Some((_, u, v)) = deepest {
+        let bottom = gouge_bottom(ctx, probe, face, u, v, du, dv);
+        acc.max_gouge = acc.max_gouge.max(-bottom);
+    }
+    acc
+}
+
+/// From a gouged sample at `(u, v)`, Newton steps towards the bottom of the gouge (where
+/// the depth's gradient vanishes), measuring at each; the deepest material left found (mm,
+/// negative).
+fn gouge_bottom(
+    ctx: &Ctx,
+    probe: &mut Probe,
+    face: &FaceSurface,
+    u: f64,
+    v: f64,
+    du: f64,
+    dv: f64,
+) -> f64 {
+    let mut at = (u, v, measure(ctx, probe, face, u, v).corner);
+    let mut best = at.2.left_mm;
+    for _ in 0..GOUGE_NEWTON_STEPS {
+        let c = &at.2;
+        if !(c.reached && c.w_mm > 0.0) {
+            break;
+        }
+        let k = second_derivative_bound(ctx.radius, c.kappa_convex, c.w_mm, c.left_mm);
+        let [e, f, g] = c.metric.map(|m| m * k);
+        let det = e * g - f * f;
+        if !(det > 0.0) {
+            break;
+        }
+        let su = -(g * c.grad[0] - f * c.grad[1]) / det;
+        let sv = -(-f * c.grad[0] + e * c.grad[1]) / det;
+        let (su, sv) = (
+            su.clamp(-GOUGE_STEP_CELLS * du, GOUGE_STEP_CELLS * du),
+            sv.clamp(-GOUGE_STEP_CELLS * dv, GOUGE_STEP_CELLS * dv),
+        );
+        let (nu, nv) = ((at.0 + su).clamp(0.0, 1.0), (at.1 + sv).clamp(0.0, 1.0));
+        let next = measure(ctx, probe, face, nu, nv).corner;
+        if !(next.reached && next.left_mm < best) {
+            break;
+        }
+        best = next.left_mm;
+        at = (nu, nv, next);
+    }
+    best
+}
+
+/// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other: the
+/// majority, over a coarse grid, of the side where the nearest ball centre lies.
+fn vote_side(ctx: &Ctx, probe: &mut Probe) -> f64 {
+    let mut votes: i64 = 0;
+    for face in ctx.surface.faces() {
+        for i in 0..SIDE_PROBE {
+            for j in 0..SIDE_PROBE {
+                let (u, v) = (
+                    (i as f64 + 0.5) / SIDE_PROBE as f64,
+                    (j as f64 + 0.5) / SIDE_PROBE as f64,
+                );
+                let Some((d, g)) = geometry(face, u, v) else {
+                    continue;
+                };
+                if let Some(c) = probe.nearest_centre(&d.point, &g.normal, 2.0 * ctx.radius) {
+                    let s = (c - d.point).dot(&g.normal);
+                    votes += if s > 0.0 {
+                        1
+                    } else if s < 0.0 {
+                        -1
+                    } else {
+                        0
+                    };
+                }
+            }
+        }
+    }
+    if votes < 0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+/// Work items: (face, first row, last row, owns first row).
+fn work_items(grids: &[FaceGrid]) -> Vec<(usize, usize, usize, bool)> {
+    let mut items = Vec::new();
+    for (fi, g) in grids.iter().enumerate() {
+        let mut j0 = 0;
+        while j0 < g.nv - 1 {
+            let j1 = (j0 + BAND_ROWS).min(g.nv - 1);
+            items.push((fi, j0, j1, j0 == 0));
+            j0 = j1;
+        }
+    }
+    items
+}
+
+fn threads(asked: usize) -> usize {
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = asked;
+        1
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        if asked > 0 {
+            asked
+        } else {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        }
+    }
+}
+
+/// Runs every work item, in parallel where threads exist; results in item order.
+fn run_items(
+    ctx: &Ctx,
+    items: &[(usize, usize, usize, bool)],
+    heat: Option<&mut HeatMap>,
+) -> Vec<Acc> {
+    let workers = threads(ctx.opts.threads).min(items.len()).max(1);
+    let new_probe = || {
+        Probe::new(
+            ctx.capsules,
+            ctx.index,
+            ctx.radius,
+            ctx.reach,
+            ctx.max_depth,
+        )
+    };
+    if workers == 1 {
+        let mut probe = new_probe();
+        let mut heat = heat;
+        return items
+            .iter()
+            .map(|&(fi, j0, j1, own)| band(ctx, &mut probe, fi, j0, j1, own, heat.as_deref_mut()))
+            .collect();
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        unreachable!("one worker on wasm")
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        use std::sync::Mutex;
+        let next = AtomicUsize::new(0);
+        let results: Mutex<Vec<Option<Acc>>> = Mutex::new(vec![None; items.len()]);
+        let template = heat.as_deref().cloned();
+        let maps: Vec<Option<HeatMap>> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..workers)
+                .map(|_| {
+                    let mut map = template.clone();
+                    let (next, results) = (&next, &results);
+                    s.spawn(move || {
+                        let mut probe = new_probe();
+                        loop {
+                            let k = next.fetch_add(1, Ordering::Relaxed);
+                            let Some(&(fi, j0, j1, own)) = items.get(k) else {
+                                break;
+                            };
+                            let acc = band(ctx, &mut probe, fi, j0, j1, own, map.as_mut());
+                            results.lock().expect("no worker panics")[k] = Some(acc);
+                        }
+                        map
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("verification worker panicked"))
+                .collect()
+        });
+        if let Some(h) = heat {
+            for m in maps.into_iter().flatten() {
+                h.merge(&m);
+            }
+        }
+        results
+            .into_inner()
+            .expect("no worker panics")
+            .into_iter()
+            .map(|a| a.expect("every item ran"))
+            .collect()
+    }
+}
+
+fn summarise(patch: u32, grid: [usize; 2], acc: &Acc) -> PatchVerification {
+    let frac = |a: f64| if acc.area > 0.0 { a / acc.area } else { 0.0 };
+    let max_scallop = acc.max_left.map_or(0.0, |m| m.max(0.0));
+    let scallop_bound = acc.upper.map_or(0.0, |u| (u - max_scallop).max(0.0));
+    let gouge_bound = acc
+        .gouge_upper
+        .map_or(0.0, |g| (g - acc.max_gouge.max(0.0)).max(0.0));
+    PatchVerification {
+        patch,
+        samples: acc.samples,
+        grid,
+        area_mm2: acc.area,
+        sample_spacing_mm: acc.spacing,
+        max_scallop_mm: max_scallop,
+        mean_scallop_mm: if acc.reached_area > 0.0 {
+            acc.scallop_area / acc.reached_area
+        } else {
+            0.0
+        },
+        p95_scallop_mm: weighted_quantile(&acc.values, PERCENTILE).unwrap_or(0.0),
+        uncut_fraction: frac(acc.uncut_area),
+        unreached_fraction: frac(acc.unreached_area),
+        unreached_samples: acc.unreached,
+        max_gouge_mm: acc.max_gouge.max(0.0),
+        gouge_count: acc.gouges,
+        gouge_fraction: frac(acc.gouge_area),
+        scallop_error_bound_mm: scallop_bound,
+        gouge_error_bound_mm: gouge_bound,
+        error_bound_mm: scallop_bound.max(gouge_bound),
+        singular_samples: acc.singular,
+        cusp_samples: acc.refined,
+    }
+}
+
+pub(super) fn run(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    mut heat: Option<&mut HeatMap>,
+) -> Verification {
+    let r = path.tool_radius_mm;
+    let reach = r;
+    let capsules = path.capsules();
+    let bbox = surface.bbox();
+    let grow = reach + r + REGION_MARGIN * bbox.diagonal();
+    let region = Aabb {
+        min: bbox.min.map(|x| x - grow),
+        max: bbox.max.map(|x| x + grow),
+    };
+    let index = CapsuleIndex::build(&capsules, r, &region, CELL_PER_RADIUS * r);
+    let grids = grids(surface, opts.samples);
+    let mut ctx = Ctx {
+        surface,
+        capsules: &capsules,
+        index: &index,
+        grids: &grids,
+        radius: r,
+        reach,
+        max_depth: region.diagonal(),
+        sigma: 1.0,
+        opts,
+    };
+    let mut probe = Probe::new(&capsules, &index, r, reach, ctx.max_depth);
+    ctx.sigma = match opts.tool_side {
+        ToolSide::Normal => 1.0,
+        ToolSide::Opposite => -1.0,
+        ToolSide::Auto => vote_side(&ctx, &mut probe),
+    };
+    let items = work_items(&grids);
+    let results = run_items(&ctx, &items, heat.as_deref_mut());
+    let mut per_face: Vec<Acc> = vec![Acc::default(); grids.len()];
+    for (&(fi, ..), acc) in items.iter().zip(results) {
+        per_face[fi].merge(acc);
+    }
+    if let Some(h) = heat {
+        for (i, p, n) in h.unfilled() {
+            let n = n * ctx.sigma;
+            let value = match probe.measure(&p, &n) {
+                Material::Left { left_mm, .. } if -left_mm > opts.gouge_tolerance_mm => {
+                    left_mm as f32
+                }
+                Material::Left { left_mm, .. } => left_mm.max(0.0) as f32,
+                Material::Unreached => f32::INFINITY,
+            };
+            h.set(i, worse(f32::NAN, value));
+        }
+    }
+    let patches: Vec<PatchVerification> = per_face
+        .iter()
+        .enumerate()
+        .map(|(fi, a)| summarise(fi as u32, [grids[fi].nu, grids[fi].nv], a))
+        .collect();
+    let mut all = Acc::default();
+    for a in per_face {
+        all.merge(a);
+    }
+    let o = summarise(u32::MAX, [0, 0], &all);
+    Verification {
+        tool_radius_mm: r,
+        requested_scallop_mm: opts.scallop_mm,
+        gouge_tolerance_mm: opts.gouge_tolerance_mm,
+        tool_side: if ctx.sigma > 0.0 {
+            ToolSide::Normal
+        } else {
+            ToolSide::Opposite
+        },
+        moves: capsules.len(),
+        samples: o.samples,
+        area_mm2: o.area_mm2,
+        sample_spacing_mm: o.sample_spacing_mm,
+        max_scallop_mm: o.max_scallop_mm,
+        mean_scallop_mm: o.mean_scallop_mm,
+        p95_scallop_mm: o.p95_scallop_mm,
+        uncut_fraction: o.uncut_fraction,
+        unreached_fraction: o.unreached_fraction,
+        unreached_samples: o.unreached_samples,
+        max_gouge_mm: o.max_gouge_mm,
+        gouge_count: o.gouge_count,
+        gouge_fraction: o.gouge_fraction,
+        scallop_error_bound_mm: o.scallop_error_bound_mm,
+        gouge_error_bound_mm: o.gouge_error_bound_mm,
+        error_bound_mm: o.error_bound_mm,
+        singular_samples: o.singular_samples,
+        cusp_samples: o.cusp_samples,
+        patches,
+    }
+}

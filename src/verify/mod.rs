@@ -1,0 +1,288 @@
+//! Verification by cutting simulation: what a ball-end tool moving along a path leaves on
+//! the design surface, measured independently of the planners.
+//!
+//! Owns: sampling the surface, the swept volume of the ball (capsules), the measurement of
+//! material left and gouges along surface normals, the error bound of that sampling, the
+//! summary and the per-vertex heat map. Must not: share code with `plan` (it takes only the
+//! [`Surface`] and a [`CutterPath`]), or change either.
+//!
+//! Method. Every patch is sampled on a uniform `(u, v)` grid, samples shared among patches
+//! by area. From each sample `p` with tool-side unit normal `n` the line `p + t·n` is
+//! intersected exactly with the capsule of every straight move near it (found through a
+//! uniform grid): the first `t ≥ 0` inside the union is the material left; if `p` itself is
+//! inside, the union's extent below `p` is the gouge depth. No ball within one tool radius
+//! along the normal means the tool never came near: such samples count as uncut and are
+//! reported apart (`unreached_fraction`), since their material left is not a scallop.
+//!
+//! Error bound. Sampled maxima underestimate the true ones; the worst scallop sits on the
+//! cusp between passes, usually between samples. [`bound`] turns each sample's exact
+//! gradient and a bound on the second derivative into a per-cell upper bound and locates
+//! the cusp, which is then measured too (`cusp_samples`); the true
+//! maximum scallop lies in `[max_scallop_mm, max_scallop_mm + scallop_error_bound_mm]` and
+//! the true deepest gouge in `[max_gouge_mm, max_gouge_mm + gouge_error_bound_mm]`;
+//! `error_bound_mm` is the larger of the two. Both fall with the square of the spacing.
+
+pub mod bound;
+pub mod capsule;
+pub mod cutter;
+mod engine;
+pub mod gcode;
+pub mod heatmap;
+pub mod index;
+pub mod probe;
+pub mod stats;
+
+pub use cutter::{CutterLocation, CutterPath, ToolTip};
+
+use crate::error::{Error, Result};
+use crate::surface::tessellate::Tessellation;
+use crate::surface::Surface;
+use serde::{Deserialize, Serialize};
+
+/// Which side of the surface the tool works from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ToolSide {
+    /// Decided from the path: the side where the ball centres near the surface are.
+    #[default]
+    Auto,
+    /// The side the surface normal `S_u × S_v` points to.
+    Normal,
+    /// The other side.
+    Opposite,
+}
+
+/// What to measure and how densely.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct VerifyOptions {
+    /// Samples on the surface in all, shared among patches by area. Default 1 000 000:
+    /// on a 50 × 50 mm part a spacing of 0.05 mm.
+    pub samples: usize,
+    /// The scallop height asked of the planner (mm): material left above it counts as
+    /// uncut. Default 0.01 mm, the planner's default.
+    pub scallop_mm: f64,
+    /// Overcut deeper than this is a gouge (mm). Default 0.0005 mm (half a micrometre): below
+    /// what machines hold, above rounding.
+    pub gouge_tolerance_mm: f64,
+    /// Side the tool works from. Default: decided from the path.
+    pub tool_side: ToolSide,
+    /// Worker threads (natively; wasm uses one). Default 0: one per available core. The
+    /// result does not depend on it.
+    pub threads: usize,
+}
+
+impl Default for VerifyOptions {
+    fn default() -> Self {
+        VerifyOptions {
+            samples: 1_000_000,
+            scallop_mm: 0.01,
+            gouge_tolerance_mm: 0.0005,
+            tool_side: ToolSide::Auto,
+            threads: 0,
+        }
+    }
+}
+
+/// Fewest and most samples accepted.
+const MIN_SAMPLES: usize = 16;
+/// Each sample keeps 16 bytes for the percentile: 50 million need 800 MB.
+const MAX_SAMPLES: usize = 50_000_000;
+
+impl VerifyOptions {
+    /// Sets the number of samples.
+    pub fn with_samples(mut self, n: usize) -> Self {
+        self.samples = n;
+        self
+    }
+    /// Sets the requested scallop height (mm).
+    pub fn with_scallop(mut self, mm: f64) -> Self {
+        self.scallop_mm = mm;
+        self
+    }
+    /// Sets the gouge tolerance (mm).
+    pub fn with_gouge_tolerance(mut self, mm: f64) -> Self {
+        self.gouge_tolerance_mm = mm;
+        self
+    }
+    /// Sets the number of worker threads (0: one per core).
+    pub fn with_threads(mut self, n: usize) -> Self {
+        self.threads = n;
+        self
+    }
+    /// Sets the tool side.
+    pub fn with_tool_side(mut self, side: ToolSide) -> Self {
+        self.tool_side = side;
+        self
+    }
+
+    /// Checks every field; the error names the field and its range.
+    pub fn validate(&self) -> Result<()> {
+        if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&self.samples) {
+            return Err(Error::param(
+                "samples",
+                format!(
+                    "must be between {MIN_SAMPLES} and {MAX_SAMPLES}, got {}",
+                    self.samples
+                ),
+            ));
+        }
+        if !(self.scallop_mm.is_finite() && self.scallop_mm > 0.0) {
+            return Err(Error::param(
+                "scallop_mm",
+                format!("must be a positive number of mm, got {}", self.scallop_mm),
+            ));
+        }
+        if !(self.gouge_tolerance_mm.is_finite() && self.gouge_tolerance_mm >= 0.0) {
+            return Err(Error::param(
+                "gouge_tolerance_mm",
+                format!(
+                    "must be zero or a positive number of mm, got {}",
+                    self.gouge_tolerance_mm
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The measurements of one patch (or of the whole surface).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PatchVerification {
+    /// Patch (domain face) index.
+    pub patch: u32,
+    /// Samples on this patch and the `u × v` grid they form.
+    pub samples: usize,
+    pub grid: [usize; 2],
+    /// Area of the patch (mm²), by the samples' quadrature.
+    pub area_mm2: f64,
+    /// Largest distance between diagonal neighbours of the sample grid (mm).
+    pub sample_spacing_mm: f64,
+    /// Largest material left over the samples the tool reached (mm).
+    pub max_scallop_mm: f64,
+    /// Area-weighted mean material left over the reached area, gouges counting as 0 (mm).
+    pub mean_scallop_mm: f64,
+    /// Area-weighted 95th percentile of the same (mm).
+    pub p95_scallop_mm: f64,
+    /// Fraction of the area with more material left than the requested scallop, the
+    /// unreached area included.
+    pub uncut_fraction: f64,
+    /// Fraction of the area no ball came within one tool radius of, along the normal.
+    pub unreached_fraction: f64,
+    pub unreached_samples: usize,
+    /// Deepest overcut below the surface (mm); 0 if none.
+    pub max_gouge_mm: f64,
+    /// Samples overcut deeper than the gouge tolerance.
+    pub gouge_count: usize,
+    /// Fraction of the area overcut deeper than the gouge tolerance.
+    pub gouge_fraction: f64,
+    /// Upper bound of (true − sampled) maximum scallop (mm), over the cells of four
+    /// neighbouring samples the tool reached (where some were not, the area is uncut anyway).
+    pub scallop_error_bound_mm: f64,
+    /// The most by which the deepest gouge can exceed `max_gouge_mm` (mm), hidden gouges
+    /// between samples included.
+    pub gouge_error_bound_mm: f64,
+    /// The larger of the two bounds (mm).
+    pub error_bound_mm: f64,
+    /// Samples where the surface has no normal (singular points); not measured.
+    pub singular_samples: usize,
+    /// Extra measurements at cusps located between samples (they enter the maximum only).
+    pub cusp_samples: usize,
+}
+
+/// The result of a verification (keys as in the JSON the CLI prints).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Verification {
+    pub tool_radius_mm: f64,
+    pub requested_scallop_mm: f64,
+    pub gouge_tolerance_mm: f64,
+    /// Side the tool worked from: `normal` or `opposite` (to `S_u × S_v`).
+    pub tool_side: ToolSide,
+    /// Straight moves simulated.
+    pub moves: usize,
+    /// Samples in all.
+    pub samples: usize,
+    pub area_mm2: f64,
+    pub sample_spacing_mm: f64,
+    pub max_scallop_mm: f64,
+    pub mean_scallop_mm: f64,
+    pub p95_scallop_mm: f64,
+    pub uncut_fraction: f64,
+    pub unreached_fraction: f64,
+    pub unreached_samples: usize,
+    pub max_gouge_mm: f64,
+    pub gouge_count: usize,
+    pub gouge_fraction: f64,
+    pub scallop_error_bound_mm: f64,
+    pub gouge_error_bound_mm: f64,
+    pub error_bound_mm: f64,
+    pub singular_samples: usize,
+    pub cusp_samples: usize,
+    /// The same per patch.
+    pub patches: Vec<PatchVerification>,
+}
+
+/// Simulates `path` over `surface` and measures what it leaves.
+pub fn verify(surface: &Surface, path: &CutterPath, opts: &VerifyOptions) -> Result<Verification> {
+    opts.validate()?;
+    Ok(engine::run(surface, path, opts, None))
+}
+
+/// Most rounds of [`verify_to_bound`].
+const BOUND_ROUNDS: usize = 6;
+/// Most growth of the sample count in one round: far from the asymptotic regime (cells
+/// whose bound is capped) the bound's excess overstates the samples needed.
+const BOUND_MAX_GROWTH: f64 = 4.0;
+/// Extra samples asked for beyond what the bound's fall with the spacing squared predicts.
+const BOUND_SAFETY: f64 = 1.1;
+
+/// As [`verify`], with as many samples as it takes for `error_bound_mm ≤ target_mm`:
+/// starting from `opts.samples`, the count grows in proportion to the bound's excess (the
+/// bound falls with the square of the spacing, so with the number of samples), for at most
+/// a few rounds; the result says what was reached.
+pub fn verify_to_bound(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    target_mm: f64,
+) -> Result<Verification> {
+    if !(target_mm.is_finite() && target_mm > 0.0) {
+        return Err(Error::param(
+            "error_bound_mm",
+            format!("the target bound must be a positive number of mm, got {target_mm}"),
+        ));
+    }
+    let mut o = opts.clone();
+    let mut v = verify(surface, path, &o)?;
+    for _ in 1..BOUND_ROUNDS {
+        if v.error_bound_mm <= target_mm || o.samples >= MAX_SAMPLES {
+            break;
+        }
+        let grow = (v.error_bound_mm / target_mm * BOUND_SAFETY).clamp(1.5, BOUND_MAX_GROWTH);
+        o.samples = ((o.samples as f64 * grow).ceil() as usize).min(MAX_SAMPLES);
+        v = verify(surface, path, &o)?;
+    }
+    Ok(v)
+}
+
+/// As [`verify`], and the heat map: one value per vertex of `mesh` (a tessellation of
+/// `surface`, e.g. from [`crate::surface::tessellate::tessellate`]): the deepest gouge
+/// there as a negative number (mm) if any, else the most material left (mm), `+∞` where the
+/// tool never came within one radius.
+pub fn verify_with_heat_map(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    mesh: &Tessellation,
+) -> Result<(Verification, Vec<f32>)> {
+    opts.validate()?;
+    if mesh.positions.len() % 3 != 0 || mesh.indices.len() != 3 * mesh.patch_ids.len() {
+        return Err(Error::param(
+            "mesh",
+            "positions must be x y z triples and every triangle needs a patch id",
+        ));
+    }
+    let mut map = heatmap::HeatMap::new(mesh);
+    let v = engine::run(surface, path, opts, Some(&mut map));
+    Ok((v, map.into_values()))
+}

@@ -1,0 +1,261 @@
+//! One measurement: from a point on the design surface, along the tool-side normal, where
+//! does the union of the swept balls begin? Above the point that is the material left
+//! (scallop); if the point itself was swept, the depth the cut went below it (gouge).
+
+use super::capsule::{Capsule, LineHit, Span};
+use super::index::CapsuleIndex;
+use crate::geom::{Point3, Vector3};
+
+/// The capsule that decides a measurement and where the line meets it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Governing {
+    /// Index of the capsule (move) in the path.
+    pub capsule: u32,
+    /// The line hit.
+    pub hit: LineHit,
+}
+
+/// What a measurement found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Material {
+    /// The swept volume begins `left_mm` along the normal from the point: positive is
+    /// material left (scallop), negative a gouge that deep. `governing.hit.t_in == left_mm`.
+    Left { left_mm: f64, governing: Governing },
+    /// No swept ball comes within the reach along the normal: the tool never came near.
+    Unreached,
+}
+
+/// A reusable query context (one per thread): the index, the capsules and scratch space.
+pub struct Probe<'a> {
+    capsules: &'a [Capsule],
+    index: &'a CapsuleIndex,
+    radius: f64,
+    /// How far above the surface a ball may be and still count as having reached it (mm).
+    reach: f64,
+    /// Deepest gouge looked for (mm).
+    max_depth: f64,
+    seen: Vec<u32>,
+    stamp: u32,
+    hits: Vec<(u32, Span)>,
+}
+
+impl<'a> Probe<'a> {
+    pub fn new(
+        capsules: &'a [Capsule],
+        index: &'a CapsuleIndex,
+        radius: f64,
+        reach: f64,
+        max_depth: f64,
+    ) -> Self {
+        Probe {
+            capsules,
+            index,
+            radius,
+            reach,
+            max_depth,
+            seen: vec![0; capsules.len()],
+            stamp: 0,
+            hits: Vec::new(),
+        }
+    }
+
+    /// Hits of the line `p + t·n` for `t` in `[lo, hi]` with every capsule near it.
+    fn gather(&mut self, p: &Point3, n: &Vector3, lo: f64, hi: f64) {
+        self.hits.clear();
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.seen.iter_mut().for_each(|s| *s = 0);
+            self.stamp = 1;
+        }
+        let (a, b) = (p + n * lo, p + n * hi);
+        let (caps, r, hits) = (self.capsules, self.radius, &mut self.hits);
+        self.index.visit(&a, &b, &mut self.seen, self.stamp, |i| {
+            if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
+                hits.push((i, h));
+            }
+        });
+    }
+
+    /// The capsule nearest to `p` (distance from its segment) within `within` mm, and the
+    /// closest point of its segment; used to tell which side of the surface the tool is on.
+    pub fn nearest_centre(&mut self, p: &Point3, n: &Vector3, within: f64) -> Option<Point3> {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.seen.iter_mut().for_each(|s| *s = 0);
+            self.stamp = 1;
+        }
+        let (a, b) = (p - n * within, p + n * within);
+        let caps = self.capsules;
+        let mut best: Option<(f64, Point3)> = None;
+        self.index.visit(&a, &b, &mut self.seen, self.stamp, |i| {
+            let c = caps[i as usize].closest_on_axis(p);
+            let d = (c - p).norm();
+            if d <= within && best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, c));
+            }
+        });
+        best.map(|(_, c)| c)
+    }
+
+    /// The measurement `left_mm` decided by capsule `i` entered along `span`.
+    fn left(&self, p: &Point3, n: &Vector3, i: u32, span: &Span) -> Material {
+        Material::Left {
+            left_mm: span.t_in,
+            governing: Governing {
+                capsule: i,
+                hit: LineHit {
+                    t_in: span.t_in,
+                    t_out: span.t_out,
+                    normal_in: self.capsules[i as usize].normal_at(self.radius, p, n, span),
+                },
+            },
+        }
+    }
+
+    /// Measures at `p` along the unit tool-side normal `n`.
+    pub fn measure(&mut self, p: &Point3, n: &Vector3) -> Material {
+        // Most points are cut within a cell's length above them: look there first. Every
+        // capsule containing `p` or entered before `near` meets the segment [0, near].
+        let near = self.index.cell_mm().min(self.reach);
+        self.gather(p, n, 0.0, near);
+        if !self.hits.iter().any(|(_, h)| h.t_in <= 0.0) {
+            if let Some(&(i, h)) = self
+                .hits
+                .iter()
+                .min_by(|a, b| a.1.t_in.total_cmp(&b.1.t_in))
+            {
+                return self.left(p, n, i, &h);
+            }
+            // Nothing near: look up to the reach.
+            self.gather(p, n, near, self.reach);
+            return match self
+                .hits
+                .iter()
+                .filter(|(_, h)| h.t_in > 0.0)
+                .min_by(|a, b| a.1.t_in.total_cmp(&b.1.t_in))
+            {
+                Some(&(i, h)) => self.left(p, n, i, &h),
+                None => Material::Unreached,
+            };
+        }
+        // The point was swept: follow overlapping capsules downwards to the deepest point of
+        // the swept region connected to it.
+        let mut lo = -near;
+        loop {
+            self.gather(p, n, lo, 0.0);
+            let mut deepest: Option<(u32, Span)> = None;
+            for &(i, h) in &self.hits {
+                if h.t_in <= 0.0 && h.t_out >= 0.0 && deepest.is_none_or(|(_, d)| h.t_in < d.t_in) {
+                    deepest = Some((i, h));
+                }
+            }
+            let Some(mut d) = deepest else {
+                // Only rounding can get here (the first look found a capsule at 0).
+                return match self.hits.first() {
+                    Some(&(i, h)) => self.left(p, n, i, &h),
+                    None => Material::Unreached,
+                };
+            };
+            loop {
+                let mut grew = false;
+                for &(i, h) in &self.hits {
+                    if h.t_in < d.1.t_in && h.t_out >= d.1.t_in {
+                        d = (i, h);
+                        grew = true;
+                    }
+                }
+                if !grew {
+                    break;
+                }
+            }
+            if d.1.t_in <= lo && lo > -self.max_depth {
+                // The cut may go deeper than this look reached: look further down.
+                lo = (lo * 4.0).max(-self.max_depth);
+                continue;
+            }
+            return self.left(p, n, d.0, &d.1);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Aabb;
+
+    /// The measurement equals a brute force over every capsule: the first entry above the
+    /// point, or the bottom of the swept region containing it.
+    #[test]
+    fn agrees_with_brute_force_over_all_capsules() {
+        let mut seed = 777u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let r = 0.5;
+        let mut capsules = Vec::new();
+        for _ in 0..300 {
+            let a = Point3::new(6.0 * rnd(), 6.0 * rnd(), r - 0.3 + 1.2 * rnd());
+            let d = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 * (rnd() - 0.5)) * 2.0;
+            capsules.push(Capsule::new(a, a + d));
+        }
+        let region = Aabb {
+            min: [-2.0, -2.0, -3.0],
+            max: [8.0, 8.0, 3.0],
+        };
+        let index = CapsuleIndex::build(&capsules, r, &region, 0.5 * r);
+        let mut probe = Probe::new(&capsules, &index, r, r, 10.0);
+        let (mut gouges, mut left, mut unreached) = (0, 0, 0);
+        for _ in 0..3000 {
+            let p = Point3::new(6.0 * rnd(), 6.0 * rnd(), 0.0);
+            let n = Vector3::new(0.2 * (rnd() - 0.5), 0.2 * (rnd() - 0.5), 1.0).normalize();
+            let spans: Vec<Span> = capsules
+                .iter()
+                .filter_map(|c| c.interval(r, &p, &n, f64::NEG_INFINITY, f64::INFINITY))
+                .collect();
+            let expect = if spans.iter().any(|s| s.t_in <= 0.0 && s.t_out >= 0.0) {
+                let mut lo = 0.0f64;
+                loop {
+                    let next = spans
+                        .iter()
+                        .filter(|s| s.t_out >= lo && s.t_in <= lo)
+                        .map(|s| s.t_in)
+                        .fold(lo, f64::min);
+                    if next == lo {
+                        break;
+                    }
+                    lo = next;
+                }
+                gouges += 1;
+                Some(lo)
+            } else {
+                let first = spans
+                    .iter()
+                    .filter(|s| s.t_in > 0.0 && s.t_in <= r)
+                    .map(|s| s.t_in)
+                    .fold(f64::INFINITY, f64::min);
+                if first.is_finite() {
+                    left += 1;
+                    Some(first)
+                } else {
+                    unreached += 1;
+                    None
+                }
+            };
+            match (probe.measure(&p, &n), expect) {
+                (Material::Left { left_mm, governing }, Some(e)) => {
+                    assert_eq!(left_mm, e);
+                    assert_eq!(governing.hit.t_in, e);
+                }
+                (Material::Unreached, None) => {}
+                (got, e) => panic!("at {p:?}: measured {got:?}, brute force {e:?}"),
+            }
+        }
+        assert!(
+            gouges > 100 && left > 100 && unreached > 10,
+            "{gouges} {left} {unreached}"
+        );
+    }
+}
