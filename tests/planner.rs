@@ -7,7 +7,7 @@
 use tspath::geom::{Point3, Vector3};
 use tspath::model::samples;
 use tspath::plan::corners::{self, corner_uv, Crossfeed};
-use tspath::plan::isoparametric::{self, corner_ids, patch_costs, ParamSurface, PatchView};
+use tspath::plan::isoparametric::{self, patch_costs, ParamSurface, PatchView};
 use tspath::plan::order::{self, CostMatrix};
 use tspath::plan::{MoveKind, PlanOptions, Toolpath};
 use tspath::Model;

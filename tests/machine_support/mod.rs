@@ -102,6 +102,7 @@ pub fn along_normals(path: &Toolpath) -> Toolpath {
         moves,
         max_predicted_scallop_mm: path.max_predicted_scallop_mm,
         runs: path.runs.clone(),
+        params: path.params.clone(),
     }
 }
 
@@ -138,6 +139,7 @@ pub fn sweep(axes: &[Vector3], r: f64, step_mm: f64, z_mm: f64) -> Toolpath {
         moves,
         max_predicted_scallop_mm: 0.0,
         runs: Vec::new(),
+        params: Vec::new(),
     }
 }
 
