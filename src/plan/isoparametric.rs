@@ -22,10 +22,28 @@ use crate::surface::{DiffGeom, Surface, SurfaceDerivs};
 
 /// Samples along a pass used to find the side step to the next pass.
 const SIDE_STEP_SAMPLES: usize = 33;
+/// Extra samples near both ends of a pass (fractions of it): at an extraordinary corner the
+/// parameterisation stretches, and the side step must shrink there too.
+const END_SAMPLES: [f64; 3] = [1e-3, 4e-3, 1.6e-2];
+
+/// Where a pass is sampled for its side step: evenly, and densely near its ends.
+fn pass_samples() -> impl Iterator<Item = f64> {
+    (0..SIDE_STEP_SAMPLES)
+        .map(|k| k as f64 / (SIDE_STEP_SAMPLES - 1) as f64)
+        .chain(END_SAMPLES.iter().flat_map(|&e| [e, 1.0 - e]))
+}
 /// Most halvings of a forward step before giving up on meeting the chordal tolerance.
 const MAX_HALVINGS: usize = 40;
 /// Bisection steps of the scallop tuning.
 const TUNING_STEPS: usize = 60;
+/// Part of the chordal tolerance the forward steps aim for: the chord is held against the
+/// curve at a few points only, and the rest covers the gap between them (dimensionless).
+const CHORD_MARGIN: f64 = 0.9;
+/// Fractions of a forward step where the chord is held against the curve.
+const CHORD_PROBES: [f64; 3] = [0.5, 0.25, 0.75];
+/// Share of the scallop height reserved for the material a straight move leaves where the
+/// surface is concave along the feed (dimensionless); the side steps use the rest.
+const CHORD_SCALLOP_SHARE: f64 = 0.1;
 /// Points closer than this fraction of the model size are the same corner.
 const CORNER_MATCH_REL: f64 = 1e-7;
 
@@ -78,8 +96,7 @@ fn at(dir: FeedDir, t: f64, w: f64) -> (f64, f64) {
 /// Parametric side step from the pass at `w` for scallop `h`: the smallest over the pass.
 fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> Result<f64> {
     let mut best = f64::INFINITY;
-    for k in 0..SIDE_STEP_SAMPLES {
-        let t = k as f64 / (SIDE_STEP_SAMPLES - 1) as f64;
+    for t in pass_samples() {
         let (u, v) = at(dir, t, w);
         let Some(dg) = geom_at(s, u, v) else { continue };
         let kappa = stepover::cross_curvature(&dg, dir);
@@ -100,8 +117,7 @@ fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> 
 fn predicted_between(s: &dyn ParamSurface, dir: FeedDir, w: f64, dw: f64, r: f64) -> f64 {
     let mut worst: f64 = 0.0;
     for &ww in &[w, w + 0.5 * dw, w + dw] {
-        for k in 0..SIDE_STEP_SAMPLES {
-            let t = k as f64 / (SIDE_STEP_SAMPLES - 1) as f64;
+        for t in pass_samples() {
             let (u, v) = at(dir, t, ww.min(1.0));
             let Some(dg) = geom_at(s, u, v) else { continue };
             let kappa = stepover::cross_curvature(&dg, dir);
@@ -260,13 +276,15 @@ fn pass_point(s: &dyn ParamSurface, dir: FeedDir, t: f64, w: f64) -> Result<(Poi
     Ok((s.subs(u, v), n))
 }
 
-/// Moving-parameter values along the pass at `w` so that chords of both the contact curve
-/// and the ball-centre curve stay within `tol` (mm).
+/// Moving-parameter values along the pass at `w` so that chords of the contact curve stay
+/// within `tol` (mm), and chords of the ball-centre curve within `tol` where they dip into
+/// the surface (an overcut) and within `leave` where they pass above it (material left,
+/// which adds to the scallop).
 pub fn forward_steps(
     s: &dyn ParamSurface,
     dir: FeedDir,
     w: f64,
-    tol: f64,
+    (tol, leave): (f64, f64),
     r: f64,
 ) -> Result<Vec<f64>> {
     let mut ts = vec![0.0];
@@ -299,12 +317,30 @@ pub fn forward_steps(
         let mut dt = first.min(1.0 - t).min(0.125);
         let mut accepted = None;
         for _ in 0..MAX_HALVINGS {
-            let pm = pass_point(s, dir, t + 0.5 * dt, w)?;
             let p1 = pass_point(s, dir, t + dt, w)?;
             let cl = |p: &(Point3, Vector3)| p.0 + p.1 * r;
-            if dist_to_segment(&pm.0, &p0.0, &p1.0) <= tol
-                && dist_to_segment(&cl(&pm), &cl(&p0), &cl(&p1)) <= tol
-            {
+            let (a, b) = (cl(&p0), cl(&p1));
+            let ab = b - a;
+            // The chord against the curve at a quarter, half and three quarters of the step
+            // (where the curvature varies the largest gap is off the middle).
+            let mut ok = true;
+            for f in CHORD_PROBES {
+                let pm = pass_point(s, dir, t + f * dt, w)?;
+                let m = cl(&pm);
+                let along = if ab.norm_squared() > 0.0 {
+                    ((m - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let off = m - (a + ab * along);
+                // The curve above the chord (along the normal): the chord dips into the material.
+                let cl_tol = if off.dot(&pm.1) >= 0.0 { tol } else { leave };
+                if dist_to_segment(&pm.0, &p0.0, &p1.0) > tol || off.norm() > cl_tol {
+                    ok = false;
+                    break;
+                }
+            }
+            if ok {
                 accepted = Some(p1);
                 break;
             }
@@ -505,7 +541,14 @@ pub fn plan(
             Crossfeed::U => (FeedDir::AlongV, fv != sv),
             Crossfeed::V => (FeedDir::AlongU, fu != su),
         };
-        let (mut ws, h_used, pred) = tuned_passes(view, dir, odd, opts.scallop_mm, r)?;
+        // The scallop budget: most to the side step, the rest to the material a straight move
+        // leaves above a surface that is concave along the feed.
+        // Eq. 5 is the small-h form of the circle geometry and comes out low by about
+        // h/(2r); ask it for correspondingly less.
+        let h_target = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
+        let h_side = h_target / (1.0 + h_target / (2.0 * r));
+        let leave = opts.chordal_mm.min(CHORD_SCALLOP_SHARE * opts.scallop_mm);
+        let (mut ws, h_used, pred) = tuned_passes(view, dir, odd, h_side, r)?;
         worst = worst.max(pred);
         // The passes start on the start corner's side and each runs away from the corner's
         // coordinate along the pass first.
@@ -519,7 +562,7 @@ pub fn plan(
         let first_move = moves.len();
         let nlines = ws.len();
         for (li, &w) in ws.iter().enumerate() {
-            let mut ts = forward_steps(view, dir, w, opts.chordal_mm, r)?;
+            let mut ts = forward_steps(view, dir, w, (CHORD_MARGIN * opts.chordal_mm, leave), r)?;
             let reversed = (li % 2 == 1) != (t_start == 1);
             if reversed {
                 ts = ts.iter().rev().copied().collect();
