@@ -6,7 +6,8 @@ import { fileURLToPath } from 'node:url';
 
 const pkg = fileURLToPath(new URL('../www/pkg/', import.meta.url));
 const wasm = await import(pkg + 'tspath.js');
-await wasm.default({ module_or_path: readFileSync(pkg + 'tspath_bg.wasm') });
+const exports = await wasm.default({ module_or_path: readFileSync(pkg + 'tspath_bg.wasm') });
+const wasmMemory = () => exports.memory;
 
 function best(fn, runs = 7) {
   let t = Infinity;
@@ -25,3 +26,18 @@ for (const name of ['keycap-convex', 'tjunction']) {
   console.log(`eval ${name}: ${count} points+derivatives in ${ms.toFixed(2)} ms = ${(count / ms / 1000).toFixed(2)} M/s`);
   m.free();
 }
+
+// Planning at the paper's settings, and the wasm memory it needed.
+for (const name of ['keycap-convex', 'keycap-concave']) {
+  const m = wasm.Model.sample(name);
+  const opts = { tool_radius_mm: 0.5, scallop_mm: 0.005, chordal_mm: 0.001 };
+  let points = 0;
+  const ms = best(() => {
+    const p = m.plan(opts, null);
+    points = p.report().cl_points;
+    p.free();
+  }, 5);
+  console.log(`plan ${name}: ${points} CL points in ${ms.toFixed(1)} ms`);
+  m.free();
+}
+console.log(`wasm memory: ${(wasmMemory().buffer.byteLength / 1048576).toFixed(1)} MB`);
