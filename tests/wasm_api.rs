@@ -145,3 +145,107 @@ fn tsm_bytes_load_through_the_same_loader() {
         "{msg}"
     );
 }
+
+/// The number after `letter` in a block (`X12.5`, `X+12.5`), if the block has that word.
+fn word(block: &str, letter: char) -> Option<f64> {
+    block
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix(letter).and_then(|v| v.parse().ok()))
+}
+
+#[wasm_bindgen_test]
+fn gcode_lines_point_at_the_block_of_each_move() {
+    let model = Model::sample("dome").unwrap();
+    let options = js_sys::Object::new();
+    js_sys::Reflect::set(&options, &"tool_radius_mm".into(), &2.0.into()).unwrap();
+    js_sys::Reflect::set(&options, &"scallop_mm".into(), &0.05.into()).unwrap();
+    js_sys::Reflect::set(&options, &"max_tilt_deg".into(), &0.0.into()).unwrap();
+    let plan = model.plan(options.into(), None).unwrap();
+    let cl = plan.cl_points().to_vec();
+    let axes = plan.axes().to_vec();
+    let n = plan.move_kinds().length() as usize;
+    // Tool-tip programs: 3-axis LinuxCNC in mm, Heidenhain on a 5-axis machine in inch.
+    for (machine, dialect, units, scale) in [
+        ("3-axis", "linuxcnc", "mm", 1.0),
+        ("table-table-ac", "heidenhain", "inch", 25.4),
+    ] {
+        let text = plan.gcode_for(machine, dialect, units).unwrap();
+        let blocks: Vec<&str> = text.lines().collect();
+        let lines = plan.gcode_lines(machine, dialect, units).unwrap().to_vec();
+        assert_eq!(lines.len(), n, "one line per move");
+        assert!(
+            lines.windows(2).all(|w| w[0] <= w[1]),
+            "lines follow the moves"
+        );
+        let mut matched = 0;
+        for (i, &line) in lines.iter().enumerate() {
+            assert!(
+                line >= 1 && (line as usize) <= blocks.len(),
+                "move {i}: line {line}"
+            );
+            let block = blocks[line as usize - 1];
+            // The tool tip: ball centre minus one radius along the axis.
+            for (k, letter) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                let tip_mm = cl[3 * i + k] - 2.0 * axes[3 * i + k];
+                if let Some(v) = word(block, letter) {
+                    assert!(
+                        (v * scale - tip_mm).abs() < 2e-3,
+                        "{dialect} move {i} line {line} `{block}`: {letter} {v} vs tip {tip_mm} mm"
+                    );
+                    matched += 1;
+                }
+            }
+        }
+        assert!(matched > 2 * n, "{dialect}: coordinates checked {matched}");
+    }
+    let msg = js_message(plan.gcode_lines("3-axis", "klingon", "mm").err().unwrap());
+    assert!(msg.contains("klingon"), "{msg}");
+}
+
+#[wasm_bindgen_test]
+fn control_edges_follow_euler_characteristic() {
+    // V − E + F = 1 for a surface with one boundary (dome, keycaps), 2 for a closed one
+    // (head); the edge count comes from the half-edges, V and F from the summary.
+    for (name, chi) in [("dome", 1.0), ("keycap-convex", 1.0), ("head", 2.0)] {
+        let model = Model::sample(name).unwrap();
+        let summary = model.summary().unwrap();
+        let v = get(&summary, "vertices").as_f64().unwrap();
+        let f = get(&summary, "faces").as_f64().unwrap();
+        let edges = model.control_edges().to_vec();
+        assert_eq!(edges.len() % 6, 0);
+        let e = (edges.len() / 6) as f64;
+        assert_eq!(v - e + f, chi, "{name}: V {v} E {e} F {f}");
+        assert!(edges.iter().all(|x| x.is_finite()));
+    }
+}
+
+#[wasm_bindgen_test]
+fn stl_bytes_hold_the_shown_triangles() {
+    let model = Model::sample("keycap-convex").unwrap();
+    let mesh = model.tessellate(0.02).unwrap();
+    let bytes = mesh.stl("keycap-convex").to_vec();
+    let positions = mesh.positions().to_vec();
+    let indices = mesh.indices().to_vec();
+    let nt = indices.len() / 3;
+    assert_eq!(bytes.len(), 84 + 50 * nt);
+    assert!(
+        bytes.starts_with(b"tspath ") && bytes[..80].windows(13).any(|w| w == b"keycap-convex")
+    );
+    assert_eq!(
+        u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize,
+        nt
+    );
+    let f = |at: usize| f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+    for t in [0, nt / 2, nt - 1] {
+        let rec = 84 + 50 * t;
+        for corner in 0..3 {
+            let vtx = indices[3 * t + corner] as usize;
+            for k in 0..3 {
+                assert_eq!(f(rec + 12 + 12 * corner + 4 * k), positions[3 * vtx + k]);
+            }
+        }
+        // The facet normal is a unit vector.
+        let n = (0..3).map(|k| f(rec + 4 * k) as f64).collect::<Vec<_>>();
+        assert!(((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-5);
+    }
+}

@@ -119,6 +119,23 @@ impl WasmModel {
         js_sys::Float64Array::from(&v[..])
     }
 
+    /// The control mesh as line segments, `x y z x y z` per edge (mm), each edge once, in
+    /// half-edge order (for drawing the cage over the surface).
+    #[wasm_bindgen(js_name = controlEdges)]
+    pub fn control_edges(&self) -> js_sys::Float64Array {
+        let mesh = &self.model.mesh;
+        let mut v: Vec<f64> = Vec::new();
+        for (h, he) in mesh.half_edges().iter().enumerate() {
+            if he.twin.is_some_and(|t| (t as usize) < h) {
+                continue;
+            }
+            let a = mesh.points()[he.origin as usize].point;
+            let b = mesh.points()[mesh.he(he.next).origin as usize].point;
+            v.extend_from_slice(&[a.x, a.y, a.z, b.x, b.y, b.z]);
+        }
+        js_sys::Float64Array::from(&v[..])
+    }
+
     /// Evaluates point and first and second derivatives on an `n × n` grid of every face and
     /// returns the number of evaluations; a timing hook for the wasm benchmark script.
     #[wasm_bindgen(js_name = benchDerivs)]
@@ -246,6 +263,11 @@ impl WasmMesh {
     pub fn patch_ids(&self) -> js_sys::Uint32Array {
         js_sys::Uint32Array::from(&self.mesh.patch_ids[..])
     }
+    /// The triangles as a binary STL file (mm), the same bytes `tspath export MODEL -o
+    /// FILE.stl` writes for the same tolerance; `name` goes into the 80-byte header.
+    pub fn stl(&self, name: &str) -> js_sys::Uint8Array {
+        js_sys::Uint8Array::from(&crate::io::export::stl(&self.mesh, name)[..])
+    }
 }
 
 /// A planned tool path with its report and G-code.
@@ -323,6 +345,50 @@ impl WasmPlan {
         let d = Dialect::parse(dialect).map_err(js_err)?;
         let u = Units::parse(units).map_err(js_err)?;
         machine::post(&self.path, &self.opts, &self.job, &m, d, u).map_err(js_err)
+    }
+
+    /// For each move, the 1-based line of the program `gcodeFor(machine, dialect, units)`
+    /// returns that ends at it (for highlighting the block beside a scrubbed tool). The lines
+    /// come from reading that program back with the machine module's reader, matched to
+    /// moves through the post's record of which move each motion block is; a move the post
+    /// wrote no block for gets the line of the block before it.
+    #[wasm_bindgen(js_name = gcodeLines)]
+    pub fn gcode_lines(
+        &self,
+        machine: &str,
+        dialect: &str,
+        units: &str,
+    ) -> Result<js_sys::Uint32Array, JsError> {
+        let m = machine::resolve(machine).map_err(js_err)?;
+        let d = Dialect::parse(dialect).map_err(js_err)?;
+        let u = Units::parse(units).map_err(js_err)?;
+        let posted = machine::post::post_program(&self.path, &self.opts, &self.job, &m, d, u)
+            .map_err(js_err)?;
+        let program = machine::reader::read(&posted.text).map_err(js_err)?;
+        if program.moves.len() != posted.sources.len() {
+            return Err(JsError::new(&format!(
+                "the program reads back {} motion blocks, the post wrote {}",
+                program.moves.len(),
+                posted.sources.len()
+            )));
+        }
+        let mut lines = vec![0u32; self.path.moves.len()];
+        for (src, block) in posted.sources.iter().zip(&program.moves) {
+            if let machine::post::Source::Move(i) = *src {
+                if let Some(l) = lines.get_mut(i) {
+                    *l = block.line as u32;
+                }
+            }
+        }
+        let mut last = 0;
+        for l in lines.iter_mut() {
+            if *l == 0 {
+                *l = last;
+            } else {
+                last = *l;
+            }
+        }
+        Ok(js_sys::Uint32Array::from(&lines[..]))
     }
 }
 
