@@ -59,7 +59,7 @@ fn sample_loads_plans_and_posts() {
         Some(kinds.length() as f64)
     );
     assert!(get(&report, "max_predicted_scallop_mm").as_f64().unwrap() <= 0.02 * (1.0 + 1e-9));
-    let gcode = plan.gcode();
+    let gcode = plan.gcode().unwrap();
     assert!(gcode.contains("G21") && gcode.contains("(model: dome)"));
     assert!(gcode.lines().filter(|l| l.starts_with("G1 ")).count() > 100);
 }
@@ -111,7 +111,7 @@ fn machine_dialect_and_units_choice() {
     assert!(dialect_names().iter().any(|n| n == "heidenhain"));
     let model = Model::sample("dome").unwrap();
     let plan = model.plan(JsValue::UNDEFINED, None).unwrap();
-    let default = plan.gcode();
+    let default = plan.gcode().unwrap();
     let fanuc = plan.gcode_for("table-table-ac", "fanuc", "inch").unwrap();
     assert!(fanuc.contains("G20") && fanuc.contains("G43.4 H1") && fanuc.contains("(model: dome)"));
     // A machine given as JSON text gives the same program as by name.
@@ -248,4 +248,33 @@ fn stl_bytes_hold_the_shown_triangles() {
         let n = (0..3).map(|k| f(rec + 4 * k) as f64).collect::<Vec<_>>();
         assert!(((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-5);
     }
+}
+
+#[wasm_bindgen_test]
+fn a_plan_stands_without_its_default_program() {
+    // Planning writes no program: each is written when asked for, for the machine asked
+    // for, so a program that cannot be written fails that request, not the plan.
+    let model = Model::sample("keycap-convex").unwrap();
+    let options = js_sys::Object::new();
+    js_sys::Reflect::set(&options, &"tool_radius_mm".into(), &0.5.into()).unwrap();
+    js_sys::Reflect::set(&options, &"scallop_mm".into(), &0.05.into()).unwrap();
+    js_sys::Reflect::set(&options, &"tilt_deg".into(), &10.0.into()).unwrap();
+    let plan = model.plan(options.into(), None).unwrap();
+    let axes = plan.axes().to_vec();
+    assert!(
+        axes.chunks(3).any(|a| a[2] < 0.99),
+        "a 10° tilt tilts the axis"
+    );
+    // Three-axis output refuses a tilted path, naming the move; the plan stays usable.
+    let msg = js_message(plan.gcode_for("3-axis", "linuxcnc", "mm").err().unwrap());
+    assert!(msg.contains("move ") && msg.contains("+Z"), "{msg}");
+    let five = plan.gcode().unwrap();
+    assert!(
+        five.contains("table-table-ac") && five.contains("G93"),
+        "default five-axis program"
+    );
+    assert!(plan
+        .gcode_for("table-table-ac", "siemens", "mm")
+        .unwrap()
+        .contains("TRAORI"));
 }

@@ -56,7 +56,7 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     // The G-code of the same plan gives the same picture (coordinates rounded to 0.1 µm).
     let g = model
         .verify_gcode(
-            &plan.gcode(),
+            &plan.gcode().unwrap(),
             2.0,
             "3-axis",
             "linuxcnc",
@@ -91,7 +91,7 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     let msg = js_message(
         model
             .verify_gcode(
-                &plan.gcode(),
+                &plan.gcode().unwrap(),
                 1.0,
                 "3-axis",
                 "linuxcnc",

@@ -1,5 +1,6 @@
 // The only importer of the generated wasm package. Everything else talks to the engine
-// through these functions, so the package can be rebuilt or moved without touching the page.
+// through these functions (in practice only worker.js, which owns the engine), so the package
+// can be rebuilt or moved without touching the page.
 import init, * as wasm from './pkg/tspath.js';
 
 let ready = null;
@@ -10,14 +11,15 @@ export function loadEngine() {
   return ready;
 }
 
-/** Names of the built-in sample models. */
-export async function sampleNames() {
-  return (await loadEngine()).sampleNames();
-}
-
-/** The engine's version string. */
-export async function version() {
-  return (await loadEngine()).version();
+/** What the engine offers: version, samples, machines (with their JSON), dialects. */
+export async function engineInfo() {
+  const w = await loadEngine();
+  return {
+    version: w.version(),
+    samples: w.sampleNames(),
+    machines: w.machineNames().map((name) => ({ name, json: w.machineJson(name) })),
+    dialects: w.dialectNames(),
+  };
 }
 
 /** A built-in sample model (a handle in wasm memory; call free() when done). */

@@ -208,30 +208,9 @@ impl WasmModel {
             model: self.model.name.clone(),
             strategy: "isoparametric".into(),
         };
-        // Three-axis G-code while the axis stays at +Z; a table-table A/C machine otherwise.
-        let three_axis = path
-            .moves
-            .iter()
-            .all(|m| m.tool_axis == crate::geom::Vector3::z());
-        let gcode = if three_axis {
-            machine::gcode_3axis(&path, &opts, &job)
-        } else {
-            machine::builtin("table-table-ac").and_then(|m| {
-                machine::post(
-                    &path,
-                    &opts,
-                    &job,
-                    &m,
-                    machine::Dialect::LinuxCnc,
-                    machine::Units::Mm,
-                )
-            })
-        }
-        .map_err(js_err)?;
         Ok(WasmPlan {
             path,
             report,
-            gcode,
             opts,
             job,
         })
@@ -275,7 +254,6 @@ impl WasmMesh {
 pub struct WasmPlan {
     path: Toolpath,
     report: PlanReport,
-    gcode: String,
     opts: PlanOptions,
     job: JobInfo,
 }
@@ -330,9 +308,31 @@ impl WasmPlan {
     pub fn report(&self) -> Result<JsValue, JsError> {
         serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))
     }
-    /// The G-code program (3-axis, plain dialect, mm).
-    pub fn gcode(&self) -> String {
-        self.gcode.clone()
+    /// The default G-code program, in mm: three-axis (plain dialect) while the tool axis
+    /// stays at +Z, else LinuxCNC joint values for the `table-table-ac` machine. Written when
+    /// asked for, so a plan whose default program cannot be written is still a plan; throws
+    /// with the machine module's reason then (see `gcodeFor` for any other choice).
+    pub fn gcode(&self) -> Result<String, JsError> {
+        let three_axis = self
+            .path
+            .moves
+            .iter()
+            .all(|m| m.tool_axis == crate::geom::Vector3::z());
+        if three_axis {
+            machine::gcode_3axis(&self.path, &self.opts, &self.job)
+        } else {
+            machine::builtin("table-table-ac").and_then(|m| {
+                machine::post(
+                    &self.path,
+                    &self.opts,
+                    &self.job,
+                    &m,
+                    Dialect::LinuxCnc,
+                    Units::Mm,
+                )
+            })
+        }
+        .map_err(js_err)
     }
 
     /// The program for a machine, dialect and units: `machine` is a built-in machine name

@@ -1,109 +1,594 @@
 // Browser end-to-end tests: serve www/ on a free port, drive Debian's headless Chromium with
-// playwright-core, and check what a user would see. Screenshots go to test-artifacts/e2e/.
-// Usage: node tests/e2e/run.mjs   (after scripts/build-wasm)
+// playwright-core, and check what a user would see and get. The numbers the page shows and
+// the files it offers are compared with the command-line tool's for the same inputs (the CLI
+// is the native build of the same library: its report, G-code and STL are independent of the
+// page, the worker and wasm). Screenshots go to test-artifacts/e2e/ (git-ignored).
+//
+// Usage: node tests/e2e/run.mjs   (after scripts/build-wasm; builds the CLI with cargo)
+// TSPATH_CLI=path uses that CLI binary instead of building target/debug/tspath.
+// Prints, without asserting: the gzipped size of the wasm and the time to the first model
+// drawn.
 import { chromium } from 'playwright-core';
-import { mkdir, readFile } from 'node:fs/promises';
+import { execFileSync } from 'node:child_process';
+import { mkdir, mkdtemp, readFile, rm, writeFile } from 'node:fs/promises';
+import { readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { gzipSync } from 'node:zlib';
 import { startServer } from '../../scripts/serve.mjs';
 
 const root = fileURLToPath(new URL('../..', import.meta.url));
 const shots = join(root, 'test-artifacts', 'e2e');
+await rm(shots, { recursive: true, force: true });
 await mkdir(shots, { recursive: true });
+const work = await mkdtemp(join(tmpdir(), 'tspath-e2e-'));
 
+// ------------------------------------------------------------------ the CLI
+let cli = process.env.TSPATH_CLI;
+if (!cli) {
+  execFileSync('cargo', ['build', '-q', '--bin', 'tspath'], { cwd: root, stdio: 'inherit' });
+  cli = join(root, 'target', 'debug', 'tspath');
+}
+const runCli = (args) => execFileSync(cli, args, { cwd: work, encoding: 'utf8', maxBuffer: 1 << 28 });
+const SAMPLES = runCli(['sample', '--list']).trim().split('\n').map((l) => l.trim().split(/\s+/)[0]);
+
+/** Plans with the CLI: the report, the program and, with `samples`, the verification. */
+function cliPlan(model, { toolRadius, scallop, machine = '3-axis', dialect = 'linuxcnc', units = 'mm', samples, extra = [] }) {
+  const stem = `${model}-${machine}-${dialect}-${units}-${scallop}`;
+  const args = ['plan', model, '--tool-radius', String(toolRadius), '--scallop', String(scallop),
+    '--machine', machine, '--dialect', dialect, '--units', units, ...extra,
+    '-o', `${stem}.nc`, '--report', `${stem}.json`];
+  if (samples) args.push('--verify', '--verify-samples', String(samples));
+  runCli(args);
+  return {
+    report: JSON.parse(readFileSync(join(work, `${stem}.json`), 'utf8')),
+    gcode: readFileSync(join(work, `${stem}.nc`), 'utf8'),
+  };
+}
+
+// ------------------------------------------------------------------ helpers
 const tests = [];
-const test = (name, fn) => tests.push({ name, fn });
+const test = (name, fn, opts = {}) => tests.push({ name, fn, opts });
 function check(cond, message) {
   if (!cond) throw new Error(message);
 }
+const HOST = 'tspath-planner';
+const attr = (page, name) => page.getAttribute(HOST, name);
+const waitState = (page, state, timeout = 60000) =>
+  page.waitForSelector(`${HOST}[data-state="${state}"]`, { timeout, state: 'attached' });
+const waitVerified = (page, timeout = 60000) =>
+  page.waitForSelector(`${HOST}[data-verify="done"]`, { timeout, state: 'attached' });
+/** Waits until the element has finished `n` plans (its data-plans counter). */
+const waitPlans = (page, n, timeout = 90000) =>
+  page.waitForFunction(([h, k]) => Number(document.querySelector(h).dataset.plans || 0) >= k, [HOST, n], { timeout });
+const plans = async (page) => Number((await attr(page, 'data-plans')) || 0);
 
-/** Counts canvas pixels that differ from the background colour. */
-async function drawnPixels(page) {
-  return page.evaluate(() => {
-    const c = document.getElementById('view');
-    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) {
-      if (Math.abs(d[i] - 0xee) + Math.abs(d[i + 1] - 0xf1) + Math.abs(d[i + 2] - 0xf5) > 24) n++;
+/** Sets a parameter field the way a user does: type, then leave the field. */
+async function setParam(page, key, value) {
+  const el = page.locator(`#p-${key}`);
+  // Closed groups open on a click on their heading.
+  if (!(await el.isVisible())) await page.locator(`details:has(#p-${key}) > summary`).click();
+  if ((await el.evaluate((e) => e.tagName)) === 'SELECT') await el.selectOption(String(value));
+  else {
+    await el.fill(String(value));
+    await el.press('Tab');
+  }
+}
+
+/** A statistic's raw value (data-value) and its text. */
+async function stat(page, id) {
+  const el = page.locator(`#stats-${id}`);
+  return { value: Number(await el.getAttribute('data-value')), text: (await el.textContent()).trim() };
+}
+
+const host = (page, fn, arg) => page.evaluate(([h, src, a]) => {
+  const el = document.querySelector(h);
+  // eslint-disable-next-line no-new-func
+  return new Function('el', 'arg', `return (${src})(el, arg);`)(el, a);
+}, [HOST, fn.toString(), arg]);
+
+async function downloadText(page, button) {
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
+  return { name: d.suggestedFilename(), bytes: await readFile(await d.path()) };
+}
+
+/** Loads a sample through the picker and waits until it is drawn. */
+async function pickSample(page, name) {
+  await page.selectOption('#sample', name);
+  await page.waitForSelector(`${HOST}[data-model="${name}"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
+}
+
+const near = (a, b, tol) => Math.abs(a - b) <= tol;
+
+/** Triangle count and area (mm²) of a binary STL. */
+function readStl(buf) {
+  const count = buf.readUInt32LE(80);
+  let area = 0;
+  for (let t = 0; t < count; t++) {
+    const v = [0, 1, 2].map((c) => [0, 1, 2].map((k) => buf.readFloatLE(84 + 50 * t + 12 + 12 * c + 4 * k)));
+    const e1 = v[1].map((x, k) => x - v[0][k]);
+    const e2 = v[2].map((x, k) => x - v[0][k]);
+    area += Math.hypot(e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]) / 2;
+  }
+  return { count, area };
+}
+
+// Coarse scallops keep the big parts quick; the tool is the page's default 0.5 mm ball.
+const SCALLOP = { dome: 0.02, 'keycap-convex': 0.02, 'keycap-concave': 0.02, head: 0.05 };
+const scallopOf = (s) => SCALLOP[s] ?? 0.04;
+const VERIFY_SAMPLES = 100000;
+
+// ------------------------------------------------------------------ tests
+const measured = {};
+
+test('the page opens and draws the first model with WebGL', async (page, url) => {
+  const t0 = Date.now();
+  await page.goto(url);
+  await waitState(page, 'model-loaded', 20000);
+  const wall = Date.now() - t0;
+  const inPage = Number(await attr(page, 'data-first-draw-ms'));
+  const nav = await page.evaluate(() => performance.now());
+  measured.firstDraw = { wall, inPage };
+  check(await attr(page, 'data-renderer') === 'webgl', 'headless Chromium (SwiftShader) should give the WebGL view');
+  const gl = await page.evaluate(() => {
+    const g = document.createElement('canvas').getContext('webgl2');
+    const info = g && g.getExtension('WEBGL_debug_renderer_info');
+    return info ? g.getParameter(info.UNMASKED_RENDERER_WEBGL) : 'unknown';
+  });
+  const { drawn, total } = await host(page, (el) => el.countPixels());
+  check(drawn > 0.05 * total, `the surface should fill part of the view: ${drawn} of ${total} pixels`);
+  check(await host(page, (el) => el.layerPixels('eps')) === 0, 'dome has no extraordinary points to mark');
+  const summary = await page.textContent('#summary');
+  check(/Patches\s*1/.test(summary) && /Size \(mm\)\s*56\.6 × 56\.6 × 20\.0/.test(summary), `summary: ${summary}`);
+  await page.screenshot({ path: join(shots, 'model-loaded.png') });
+  return `first model drawn ${inPage} ms after the page started (${wall} ms from navigation to drawn; page clock ${Math.round(nav)} ms); WebGL renderer: ${gl}`;
+});
+
+for (const name of SAMPLES) {
+  test(`sample ${name}: loads, plans, shows the path, matches the CLI, G-code names the model`, async (page, url) => {
+    const scallop = scallopOf(name);
+    await page.goto(`${url}?model=${name}`);
+    await page.waitForSelector(`${HOST}[data-model="${name}"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
+    await setParam(page, 'scallop', scallop);
+    await setParam(page, 'samples', VERIFY_SAMPLES);
+    await page.click('#plan');
+    await waitPlans(page, 1);
+    await waitVerified(page);
+    const pathPixels = await host(page, (el) => el.layerPixels('path'));
+    check(pathPixels > 2000, `the path should be drawn: it changes only ${pathPixels} pixels`);
+    const summary = await page.textContent('#summary');
+
+    const cli = cliPlan(name, { toolRadius: 0.5, scallop, samples: VERIFY_SAMPLES });
+    const r = cli.report;
+    for (const id of ['cl_points', 'retractions', 'reversals', 'patches']) {
+      const s = await stat(page, id);
+      check(s.value === r[id], `${id}: page ${s.value}, CLI ${r[id]}`);
+      check(s.text.replace(/,/g, '') === String(r[id]), `${id} shown as ${s.text}, CLI ${r[id]}`);
     }
-    return n;
+    for (const [id, digits] of [['length_mm', 1], ['cutting_length_mm', 1], ['max_predicted_scallop_mm', 4]]) {
+      const s = await stat(page, id);
+      check(near(s.value, r[id], 1e-9 * Math.max(1, r[id])), `${id}: page ${s.value}, CLI ${r[id]}`);
+      check(s.text === `${r[id].toFixed(digits)} mm`, `${id} shown as ${s.text}, CLI ${r[id].toFixed(digits)} mm`);
+    }
+    const time = await stat(page, 'machining_time_min');
+    check(near(time.value, r.machining_time_min, 1e-9 * r.machining_time_min), `time: page ${time.value}, CLI ${r.machining_time_min}`);
+    for (const id of ['max_scallop_mm', 'mean_scallop_mm', 'max_gouge_mm', 'error_bound_mm']) {
+      const s = await stat(page, id);
+      const want = r.verify[id] ?? Infinity; // JSON writes an infinite bound as null
+      check(s.value === want || near(s.value, want, 1e-7), `${id}: page ${s.value}, CLI --verify ${r.verify[id]}`);
+    }
+    const sim = await stat(page, 'max_scallop_mm');
+    check(sim.text === `${r.verify.max_scallop_mm.toFixed(4)} mm`, `simulated scallop shown as ${sim.text}`);
+
+    const { name: file, bytes } = await downloadText(page, '#download-gcode');
+    const gcode = bytes.toString('utf8');
+    check(file === `${name}-linuxcnc.nc`, `G-code file name ${file}`);
+    check(gcode.includes(`(model: ${name})`) && gcode.includes('G21'), 'the G-code header names the model and the units');
+    check(gcode === cli.gcode, `the page's G-code should be the CLI's byte for byte (${gcode.length} vs ${cli.gcode.length} bytes)`);
+    await page.screenshot({ path: join(shots, `sample-${name}.png`) });
+    const notes = (await page.textContent('#notes')).trim();
+    return `${r.cl_points} CL points, ${r.length_mm.toFixed(1)} mm, simulated scallop ${r.verify.max_scallop_mm.toFixed(4)} mm, path ${pathPixels} px${notes ? `; note shown: ${notes.slice(0, 60)}…` : ''} — ${summary.includes('Patches') ? 'summary shown' : ''}`;
   });
 }
 
-test('sample loads, plans, draws and downloads G-code', async (page, url) => {
-  const t0 = Date.now();
-  await page.goto(url);
-  await page.waitForSelector('body[data-state="model-loaded"]', { timeout: 20000 });
-  const firstDraw = Date.now() - t0;
-  const before = await drawnPixels(page);
-  check(before > 10000, `the surface should be drawn, only ${before} pixels differ from the background`);
-  await page.screenshot({ path: join(shots, 'model-loaded.png') });
-
+test('five-axis machine, dialect and units: program, CL data and STL downloads', async (page, url) => {
+  await page.goto(`${url}?model=keycap-convex&scallop=0.02&samples=${VERIFY_SAMPLES}`);
+  await waitState(page, 'model-loaded');
+  await setParam(page, 'machine', 'table-table-ac');
+  check(!(await page.isDisabled('#p-tilt')), 'tilt is editable on a five-axis machine');
+  await setParam(page, 'tilt', 10);
+  await setParam(page, 'dialect', 'fanuc');
+  await setParam(page, 'units', 'inch');
   await page.click('#plan');
-  await page.waitForSelector('body[data-state="planned"]', { timeout: 60000 });
-  const after = await drawnPixels(page);
-  check(after > before, `the path should add drawn pixels (${before} before, ${after} after)`);
-  const report = await page.textContent('#report');
-  check(/CL points/.test(report) && /mm/.test(report), `the report should show numbers with units: ${report}`);
-  await page.screenshot({ path: join(shots, 'planned.png') });
+  await waitPlans(page, 1);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const cli = cliPlan('keycap-convex', { toolRadius: 0.5, scallop: 0.02, machine: 'table-table-ac', dialect: 'fanuc', units: 'inch', extra: ['--tilt', '10'] });
+  const g = await downloadText(page, '#download-gcode');
+  check(g.name === 'keycap-convex-fanuc.nc', g.name);
+  const text = g.bytes.toString('utf8');
+  check(text.includes('G20') && text.includes('G43.4') && text.includes('(model: keycap-convex)'), 'Fanuc inch program with TCP');
+  check(text === cli.gcode, 'the five-axis Fanuc program equals the CLI one');
+  check((await stat(page, 'max_axis_step_deg')).value === cli.report.max_axis_step_deg, 'axis step matches');
 
-  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download')]);
-  check(download.suggestedFilename() === 'dome.nc', `download name ${download.suggestedFilename()}`);
-  const gcode = await readFile(await download.path(), 'utf8');
-  check(gcode.includes('G21') && gcode.includes('(model: dome)'), 'G-code header names units and model');
-  const feeds = gcode.split('\n').filter((l) => l.startsWith('G1 ')).length;
-  check(feeds > 1000, `G-code should hold the planned feed moves, found ${feeds}`);
-  check(/M2\s*\n%\s*$/.test(gcode), 'G-code ends the program');
-  return `first model drawn ${firstDraw} ms after navigation; ${feeds} G1 lines`;
+  // Another dialect is written from the same plan, without planning again.
+  const before = await plans(page);
+  await setParam(page, 'dialect', 'heidenhain');
+  await page.waitForSelector('#download-gcode:has-text("heidenhain")', { state: 'attached' });
+  const h = await downloadText(page, '#download-gcode');
+  check(h.name === 'keycap-convex-heidenhain.h' && h.bytes.toString('utf8').includes('BEGIN PGM KEYCAP-CONVEX INCH'), `Heidenhain program ${h.name}`);
+  check(await plans(page) === before, 'changing the dialect re-posts, it does not re-plan');
+
+  // The plain (three-axis) dialect cannot write a tilted path: the reason is shown.
+  await setParam(page, 'dialect', 'plain');
+  await page.waitForSelector('#status.error', { state: 'attached' });
+  const msg = await page.textContent('#status');
+  check(/not \+Z/.test(msg) && /plain/.test(msg), `error for a tilted path in plain G-code: ${msg}`);
+  await page.screenshot({ path: join(shots, 'dialect-error.png') });
+
+  // CL data: one row per move, the ball centres and axes of the plan.
+  const csv = (await downloadText(page, '#download-csv')).bytes.toString('utf8').trim().split('\n');
+  check(csv[0].startsWith('move,kind,patch,cl_x_mm,cl_y_mm,cl_z_mm,axis_i,axis_j,axis_k'), csv[0]);
+  check(csv.length - 1 === cli.report.cl_points, `CSV rows ${csv.length - 1}, CL points ${cli.report.cl_points}`);
+  const tilted = csv.slice(1).filter((row) => Number(row.split(',')[8]) < 0.9999).length;
+  check(tilted > 0.5 * cli.report.cl_points, `a 10° tilt tilts the axis: ${tilted} rows`);
+  for (const row of csv.slice(1)) {
+    const [, , , , , , i, j, k] = row.split(',').map(Number);
+    check(near(Math.hypot(i, j, k), 1, 2e-6), `tool axis must be a unit vector: ${row}`);
+  }
+
+  // Surface STL: the CLI's export at the tolerance the page drew with. Native and wasm
+  // arithmetic may split a few cells along the other diagonal, so triangles are compared
+  // one by one and the area as a whole.
+  const chordal = await attr(page, 'data-mesh-chordal-mm');
+  const stl = await downloadText(page, '#download-stl');
+  runCli(['export', 'keycap-convex', '-o', 'k.stl', '--chordal', chordal]);
+  const want = readFileSync(join(work, 'k.stl'));
+  check(stl.name === 'keycap-convex.stl', stl.name);
+  const a = readStl(stl.bytes);
+  const b = readStl(want);
+  check(stl.bytes.subarray(0, 84).equals(want.subarray(0, 84)), 'STL header and triangle count as the CLI writes them');
+  check(stl.bytes.length === 84 + 50 * a.count, 'binary STL size');
+  let same = 0;
+  for (let t = 0; t < a.count; t++) if (stl.bytes.subarray(84 + 50 * t, 134 + 50 * t).equals(want.subarray(84 + 50 * t, 134 + 50 * t))) same++;
+  check(same >= 0.99 * a.count, `${same} of ${a.count} triangles as the CLI export`);
+  check(near(a.area, b.area, 1e-4 * b.area), `surface area ${a.area} vs CLI ${b.area} mm²`);
+  return `Fanuc/inch program = CLI; CSV ${csv.length - 1} rows; STL ${a.count} triangles, ${same} identical to the CLI export at ${chordal} mm, area ${a.area.toFixed(3)} mm² (CLI ${b.area.toFixed(3)})`;
 });
 
-test('a malformed file shows an error and the page stays usable', async (page, url) => {
-  await page.goto(url);
-  await page.waitForSelector('body[data-state="model-loaded"]', { timeout: 20000 });
+test('the tool scrubs along the path and the G-code block of each move is highlighted', async (page, url) => {
+  await page.goto(`${url}?model=keycap-concave&scallop=0.03&samples=${VERIFY_SAMPLES}&plan=1`);
+  await waitPlans(page, 1);
+  await page.waitForSelector('#listing li.current', { state: 'attached' });
+  const cli = cliPlan('keycap-concave', { toolRadius: 0.5, scallop: 0.03 });
+  const blocks = cli.gcode.split('\n');
+  const n = cli.report.cl_points;
+  const r = 0.5;
+  const checkAt = async (move) => {
+    await page.waitForSelector(`${HOST}[data-move="${move}"]`, { state: 'attached' });
+    const line = Number(await page.getAttribute('#listing', 'data-line'));
+    const current = (await page.textContent('#listing li.current')).trim();
+    check(current === blocks[line - 1].trim(), `highlighted line ${line}: “${current}” vs program “${blocks[line - 1]}”`);
+    const readout = await page.textContent('#tool-readout');
+    const centre = readout.match(/ball centre (-?[\d.]+), (-?[\d.]+), (-?[\d.]+) mm/).slice(1).map(Number);
+    const word = (l) => Number((current.match(new RegExp(`${l}(-?[\\d.]+)`)) || [])[1]);
+    // Three-axis program: the tool tip is the ball centre one radius down.
+    for (const [k, l] of ['X', 'Y', 'Z'].entries()) {
+      const tip = centre[k] - (k === 2 ? r : 0);
+      if (!Number.isNaN(word(l))) check(near(word(l), tip, 2e-3), `move ${move} ${l}${word(l)} vs tool tip ${tip} (${readout})`);
+    }
+    return line;
+  };
+  await page.focus('#scrub');
+  await page.keyboard.press('End');
+  const lastLine = await checkAt(n - 1);
+  await page.keyboard.press('Home');
+  await checkAt(0);
+  for (let i = 0; i < 40; i++) await page.keyboard.press('ArrowRight');
+  await checkAt(40);
+  const toolPixels = await host(page, (el) => el.layerPixels('tool'));
+  check(toolPixels > 50, `the tool should be drawn (${toolPixels} px)`);
+  await page.keyboard.press('PageUp');
+  const mid = Number(await attr(page, 'data-move'));
+  check(mid > 40, `PageUp moves on (${mid})`);
+  const midLine = await checkAt(mid);
+  check(midLine > 0 && midLine < lastLine, 'lines follow the moves');
+  await page.click('#play');
+  await page.waitForFunction(([h, m]) => Number(document.querySelector(h).dataset.move) > m + 5, [HOST, mid]);
+  await page.click('#play');
+  await page.screenshot({ path: join(shots, 'scrubbed-tool.png') });
+  return `${n} moves, last move on line ${lastLine}; play advances the tool`;
+});
+
+test('heat map overlay from the cutting simulation', async (page, url) => {
+  await page.goto(`${url}?model=keycap-convex&scallop=0.02&samples=${VERIFY_SAMPLES}&plan=1`);
+  await waitVerified(page);
+  check(!(await page.isDisabled('#colour-heat')), 'heat map available once simulated');
+  const changed = await host(page, (el) => el.pixelsChangedBy(() => {
+    el.shadowRoot.getElementById('colour-heat').click();
+  }));
+  check(changed > 2000, `the heat map should recolour the surface (${changed} px)`);
+  check(await page.isVisible('#heat-legend'), 'the heat legend is shown');
+  const legend = await page.textContent('#heat-legend');
+  check(/0\.02 mm left/.test(legend) && /gouge/.test(legend), legend);
+  await page.uncheck('#layer-path');
+  await page.screenshot({ path: join(shots, 'heat-map.png') });
+
+  // A fast plan is redone on change, without pressing Plan.
+  const before = await plans(page);
+  await setParam(page, 'scallop', 0.03);
+  await waitPlans(page, before + 1);
+  const cl = (await stat(page, 'cl_points')).value;
+  const want = cliPlan('keycap-convex', { toolRadius: 0.5, scallop: 0.03 }).report.cl_points;
+  check(cl === want, `re-planned on change: ${cl} CL points, CLI ${want}`);
+  check(new URL(page.url()).searchParams.get('scallop') === '0.03', 'the URL follows');
+  return `heat map recolours ${changed} px; re-planned on change to ${cl} CL points`;
+});
+
+test('a malformed file shows an error and the previous model stays usable', async (page, url) => {
+  await page.goto(`${url}?model=keycap-convex`);
+  await waitState(page, 'model-loaded');
+  const summaryBefore = await page.textContent('#summary');
   await page.setInputFiles('#file', {
     name: 'broken.json',
     mimeType: 'application/json',
     buffer: Buffer.from('{"format": "tspath-tmesh", "version": 1, "points": [[0, 0'),
   });
-  await page.waitForSelector('#status.error', { timeout: 10000 });
+  await page.waitForSelector('#status.error', { state: 'attached' });
   const msg = await page.textContent('#status');
   check(/broken\.json/.test(msg) && /line \d+ column \d+/.test(msg), `error should name file and line: ${msg}`);
+  check(await attr(page, 'data-model') === 'keycap-convex', 'the previous model stays');
+  check(await page.textContent('#summary') === summaryBefore, 'the summary still describes it');
+  check(await page.inputValue('#sample') === 'keycap-convex', 'the picker still shows it');
   await page.screenshot({ path: join(shots, 'bad-file.png') });
+
+  // Dropped on the view: a cage whose face names a vertex that does not exist.
+  const drop = (fileName, text) => host(page, (el, [f, t]) => {
+    const dt = new DataTransfer();
+    dt.items.add(new File([t], f, { type: 'text/plain' }));
+    const canvas = el.shadowRoot.getElementById('view');
+    for (const type of ['dragenter', 'dragover', 'drop']) {
+      canvas.dispatchEvent(new DragEvent(type, { dataTransfer: dt, bubbles: true, composed: true, cancelable: true }));
+    }
+  }, [fileName, text]);
+  await drop('cage.obj', 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 9\n');
+  await page.waitForFunction(() => /cage\.obj/.test(document.querySelector('tspath-planner').shadowRoot.getElementById('status').textContent));
+  const dropMsg = await page.textContent('#status');
+  check(/cage\.obj/.test(dropMsg) && /line 5/.test(dropMsg), `drop error should name the file and line: ${dropMsg}`);
+  check(await attr(page, 'data-model') === 'keycap-convex', 'still the previous model');
+
+  await setParam(page, 'scallop', 0.03);
   await page.click('#plan');
-  await page.waitForSelector('body[data-state="planned"]', { timeout: 60000 });
-  return `error shown: "${msg.trim()}"`;
+  await waitPlans(page, 1);
+  const cl = await stat(page, 'cl_points');
+  const want = cliPlan('keycap-convex', { toolRadius: 0.5, scallop: 0.03 }).report.cl_points;
+  check(cl.value === want, `the previous model plans as before: ${cl.value} vs CLI ${want}`);
+
+  // A good file dropped after the bad ones opens.
+  const json = runCli(['sample', 'dome']);
+  await drop('my-dome.json', json);
+  await page.waitForSelector(`${HOST}[data-model="dome"][data-state="model-loaded"]`, { state: 'attached' });
+  check(await page.inputValue('#sample') === '', 'a file is not a sample');
+  return `errors shown: “${msg.trim()}” / “${dropMsg.trim()}”`;
 });
 
-const { server, url } = await startServer(0, '127.0.0.1');
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  args: [
-    '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync',
-  ],
+test('Cancel stops a long plan within 0.5 s; the page answers clicks while planning', async (page, url) => {
+  // The closed head on a five-axis machine: the collision-checked axis search takes minutes.
+  await page.goto(`${url}?model=head&machine=table-table-ac`);
+  await waitState(page, 'model-loaded');
+  await page.click('#plan');
+  await waitState(page, 'planning');
+  await page.waitForFunction(() => document.querySelector('tspath-planner').shadowRoot.getElementById('progress').value > 0, null, { timeout: 30000 });
+  await page.screenshot({ path: join(shots, 'planning.png') });
+  // The page answers while the worker plans.
+  const t0 = Date.now();
+  await page.click('#layer-cage');
+  const clickMs = Date.now() - t0;
+  check(await page.isChecked('#layer-cage'), 'the click took effect during planning');
+  const lag = await page.evaluate(() => new Promise((ok) => {
+    const t = performance.now();
+    setTimeout(() => ok(performance.now() - t), 0);
+  }));
+  await page.click('#layer-cage');
+  await page.click('#fit');
+  check(await attr(page, 'data-state') === 'planning', 'still planning');
+  const progress = await page.evaluate(() => document.querySelector('tspath-planner').shadowRoot.getElementById('progress').value);
+
+  // Cancel: from the click to the page saying planning stopped, timed in the page.
+  const cancel = await host(page, (el) => new Promise((ok) => {
+    const t = performance.now();
+    const obs = new MutationObserver(() => {
+      if (el.dataset.state !== 'planning') {
+        obs.disconnect();
+        ok({ ms: performance.now() - t, state: el.dataset.state });
+      }
+    });
+    obs.observe(el, { attributes: true });
+    el.shadowRoot.getElementById('cancel').click();
+  }));
+  check(cancel.ms <= 500, `cancel took ${cancel.ms} ms`);
+  check(cancel.state === 'model-loaded', `after cancel: ${cancel.state}`);
+  check(/cancelled/i.test(await page.textContent('#status')), 'the status says so');
+  await page.screenshot({ path: join(shots, 'cancelled.png') });
+
+  // The engine is free at once: a three-axis plan of the same model runs and finishes.
+  const t1 = Date.now();
+  await setParam(page, 'machine', '3-axis');
+  await setParam(page, 'scallop', 0.1);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  const after = Date.now() - t1;
+  const cl = (await stat(page, 'cl_points')).value;
+  const want = cliPlan('head', { toolRadius: 0.5, scallop: 0.1 }).report.cl_points;
+  check(cl === want, `plan after cancel: ${cl} CL points, CLI ${want}`);
+  measured.cancelMs = cancel.ms;
+  return `cancel ${cancel.ms.toFixed(1)} ms (at ${(100 * progress).toFixed(1)} % done); click during planning answered in ${clickMs} ms, event-loop lag ${lag.toFixed(1)} ms; next plan done ${after} ms later`;
 });
+
+test('the URL reproduces a plan', async (page, url, context) => {
+  await page.goto(url);
+  await waitState(page, 'model-loaded');
+  await pickSample(page, 'bumps-hole');
+  await setParam(page, 'scallop', 0.05);
+  await setParam(page, 'tool-radius', 0.8);
+  await setParam(page, 'feed', 2400);
+  await setParam(page, 'start-patch', 3);
+  await setParam(page, 'samples', VERIFY_SAMPLES);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  const link = page.url();
+  const q = new URL(link).searchParams;
+  check(q.get('model') === 'bumps-hole' && q.get('scallop') === '0.05' && q.get('tool-radius') === '0.8'
+    && q.get('feed') === '2400' && q.get('start-patch') === '3' && q.get('plan') === '1', `URL ${link}`);
+  const ids = ['cl_points', 'length_mm', 'reversals', 'machining_time_min'];
+  const first = await Promise.all(ids.map((id) => stat(page, id)));
+
+  const other = await context.newPage();
+  await other.goto(link);
+  await waitPlans(other, 1);
+  const second = await Promise.all(ids.map((id) => stat(other, id)));
+  ids.forEach((id, k) => check(first[k].value === second[k].value, `${id}: ${first[k].value} then ${second[k].value}`));
+  for (const [key, v] of [['scallop', '0.05'], ['tool-radius', '0.8'], ['feed', '2400'], ['start-patch', '3']]) {
+    check(await other.inputValue(`#p-${key}`) === v, `${key} restored from the URL`);
+  }
+  const cli = cliPlan('bumps-hole', { toolRadius: 0.8, scallop: 0.05, extra: ['--feed', '2400', '--start-patch', '3'] });
+  check(second[0].value === cli.report.cl_points && near(second[1].value, cli.report.length_mm, 1e-9 * cli.report.length_mm),
+    `the reopened plan is the CLI plan: ${second[0].value} / ${second[1].value} vs ${cli.report.cl_points} / ${cli.report.length_mm}`);
+  await other.screenshot({ path: join(shots, 'from-url.png') });
+  return link.replace(url, '/');
+});
+
+test('the embed example renders the element', async (page, url) => {
+  await page.goto(`${url}examples/embed.html`);
+  const scripts = await page.$$eval('script', (s) => s.map((x) => x.getAttribute('src')));
+  check(scripts.length === 1 && scripts[0].endsWith('tspath-planner.js'), `one script tag: ${scripts}`);
+  await waitPlans(page, 1);
+  check(await attr(page, 'data-model') === 'keycap-convex', 'the model attribute chose the sample');
+  check(await page.inputValue('#p-scallop') === '0.01', 'the scallop attribute set the parameter');
+  const pathPixels = await host(page, (el) => el.layerPixels('path'));
+  check(pathPixels > 1000, `path drawn in the embedded element (${pathPixels} px)`);
+  const cli = cliPlan('keycap-convex', { toolRadius: 0.5, scallop: 0.01 });
+  check((await stat(page, 'cl_points')).value === cli.report.cl_points, 'embedded plan = CLI plan');
+  check(new URL(page.url()).search === '', 'an embedded element leaves the course page URL alone');
+  await page.screenshot({ path: join(shots, 'embed.png'), fullPage: true });
+  return `${cli.report.cl_points} CL points in the embedded planner`;
+});
+
+test('layout at 1024 px; labelled, keyboard-usable controls; parameter validation', async (page, url) => {
+  await page.goto(`${url}?model=tjunction`);
+  await waitState(page, 'model-loaded');
+  const layout = await page.evaluate(() => {
+    const el = document.querySelector('tspath-planner');
+    const box = (id) => el.shadowRoot.getElementById(id).getBoundingClientRect();
+    return { scroll: document.documentElement.scrollWidth, view: box('view'), stats: box('stats'), plan: box('plan') };
+  });
+  check(layout.scroll <= 1024, `no horizontal scrolling at 1024 px (${layout.scroll} px wide)`);
+  check(layout.view.width >= 500 && layout.view.height >= 300, `the view stays large: ${layout.view.width}×${layout.view.height}`);
+  // Every control has a name a screen reader says.
+  const unnamed = await page.evaluate(() => {
+    const r = document.querySelector('tspath-planner').shadowRoot;
+    return [...r.querySelectorAll('input, select, button, canvas, progress')].filter((c) => {
+      const label = (c.labels && [...c.labels].map((l) => l.textContent).join('').trim())
+        || c.getAttribute('aria-label') || (c.tagName === 'BUTTON' && c.textContent.trim());
+      return !label;
+    }).map((c) => c.id || c.outerHTML.slice(0, 60));
+  });
+  check(unnamed.length === 0, `controls without a label: ${unnamed.join(', ')}`);
+  // Keyboard: a wrong value is marked and explained, and planning waits for a right one.
+  await page.focus('#p-scallop');
+  await page.keyboard.press('Control+A');
+  await page.keyboard.type('0.7');
+  await page.keyboard.press('Tab');
+  check(await page.getAttribute('#p-scallop', 'aria-invalid') === 'true', 'scallop ≥ tool radius is refused');
+  const why = await page.textContent('#p-scallop-error');
+  check(/smaller than the ball-end radius/.test(why), why);
+  check(await page.isDisabled('#plan'), 'plan waits for valid parameters');
+  await page.screenshot({ path: join(shots, 'invalid-parameter.png') });
+  await page.focus('#p-scallop');
+  await page.keyboard.press('Control+A');
+  await page.keyboard.type('0.04');
+  await page.keyboard.press('Tab');
+  check(await page.getAttribute('#p-scallop', 'aria-invalid') === 'false', 'fixed');
+  // The plan button and the view work from the keyboard.
+  await page.focus('#plan');
+  await page.keyboard.press('Enter');
+  await waitPlans(page, 1);
+  await page.focus('#view');
+  const before = await host(page, (el) => el.view.snapshot().length);
+  const moved = await host(page, (el) => el.pixelsChangedBy(() => {
+    el.shadowRoot.getElementById('view').dispatchEvent(new KeyboardEvent('keydown', { key: 'ArrowLeft', bubbles: true }));
+  }));
+  check(before > 0 && moved > 1000, `arrow keys orbit the view (${moved} px changed)`);
+  await page.screenshot({ path: join(shots, 'layout-1024.png') });
+  return `view ${Math.round(layout.view.width)}×${Math.round(layout.view.height)} px at 1024 px`;
+}, { viewport: { width: 1024, height: 768 } });
+
+test('without WebGL the 2D view draws the model and the path', async (page, url) => {
+  await page.goto(`${url}?model=plate-hole&scallop=0.05&samples=${VERIFY_SAMPLES}&plan=1`);
+  await waitPlans(page, 1);
+  check(await attr(page, 'data-renderer') === '2d', 'the fallback view is used');
+  const { drawn, total } = await host(page, (el) => el.countPixels());
+  check(drawn > 0.05 * total, `surface drawn: ${drawn} of ${total}`);
+  const pathPixels = await host(page, (el) => el.layerPixels('path'));
+  check(pathPixels > 1000, `path drawn (${pathPixels} px)`);
+  check(await host(page, (el) => el.layerPixels('eps')) > 0, 'extraordinary points marked');
+  await page.screenshot({ path: join(shots, 'fallback-2d.png') });
+  return `2D view: ${drawn} px drawn, path ${pathPixels} px`;
+}, { noWebGL: true });
+
+// ------------------------------------------------------------------ run
+const wasmBytes = readFileSync(join(root, 'www', 'pkg', 'tspath_bg.wasm'));
+const wasmGz = gzipSync(wasmBytes, { level: 9 }).length;
+
+const { server, url } = await startServer(0, '127.0.0.1');
+const FLAGS = [
+  '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync',
+];
+const launch = (extra = []) => chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: [...FLAGS, ...extra],
+});
+const browser = await launch();
+let noGl = null;
 let failed = 0;
+const only = process.env.TSPATH_E2E_ONLY;
+const selected = tests.filter((t) => !only || t.name.includes(only));
+const started = Date.now();
 try {
-  for (const { name, fn } of tests) {
-    const context = await browser.newContext({ acceptDownloads: true, viewport: { width: 1280, height: 860 } });
+  for (const { name, fn, opts } of selected) {
+    const b = opts.noWebGL ? (noGl ||= await launch(['--disable-webgl', '--disable-3d-apis'])) : browser;
+    const context = await b.newContext({ acceptDownloads: true, viewport: opts.viewport || { width: 1280, height: 860 } });
     const page = await context.newPage();
     const errors = [];
-    page.on('pageerror', (e) => errors.push(e.message));
+    const onError = (e) => errors.push(e.message);
+    context.on('page', (p) => p.on('pageerror', onError));
+    page.on('pageerror', onError);
     const t0 = Date.now();
     try {
-      const note = await fn(page, url);
+      const note = await fn(page, url, context);
       check(errors.length === 0, `uncaught page errors: ${errors.join('; ')}`);
       console.log(`ok   ${name} (${Date.now() - t0} ms)${note ? ` — ${note}` : ''}`);
     } catch (e) {
       failed++;
-      await page.screenshot({ path: join(shots, `FAILED-${tests.indexOf(tests.find((t) => t.name === name))}.png`) }).catch(() => {});
-      console.log(`FAIL ${name}: ${e.message}`);
+      const shot = `FAILED-${selected.findIndex((t) => t.name === name)}.png`;
+      await page.screenshot({ path: join(shots, shot) }).catch(() => {});
+      const status = await page.textContent('#status').catch(() => '?');
+      console.log(`FAIL ${name}: ${e.message}\n     page status: ${status}; screenshot ${shot}`);
     }
     await context.close();
   }
 } finally {
   await browser.close();
+  if (noGl) await noGl.close();
   server.close();
+  await rm(work, { recursive: true, force: true });
 }
-console.log(`${tests.length - failed} passed, ${failed} failed; screenshots in test-artifacts/e2e/`);
+console.log(`wasm: ${wasmBytes.length} bytes, ${wasmGz} gzipped (${(wasmGz / 1024).toFixed(1)} KB; target ≤ 400 KB)`);
+if (measured.firstDraw) {
+  console.log(`first model drawn: ${measured.firstDraw.inPage} ms after the page started, ${measured.firstDraw.wall} ms from navigation (target ≤ 1000 ms)`);
+}
+if (measured.cancelMs !== undefined) console.log(`cancel: planning stopped ${measured.cancelMs.toFixed(1)} ms after the click`);
+console.log(`browser tests took ${((Date.now() - started) / 1000).toFixed(0)} s; screenshots in test-artifacts/e2e/`);
+console.log(`${selected.length - failed} passed, ${failed} failed`);
 process.exit(failed ? 1 : 0);

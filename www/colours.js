@@ -1,0 +1,46 @@
+// Colours shared by the 3D view, its 2D fallback and the legends: patches, path kinds and the
+// scallop heat map. sRGB hex.
+
+/** Surface colour of patch i (cycled). */
+export const PATCH_COLOURS = [
+  0x7aa6dc, 0xe6a25a, 0x7cc08a, 0xd77a8e, 0xab8fd6, 0xcfc066, 0x6cc0c0, 0xc29878,
+  0x9bb4e8, 0xe08d6e, 0x97cf7a, 0xb08bc4,
+];
+
+/** Path colour of patch i: a darker shade of its surface colour, readable over it. */
+export function pathColour(patch) {
+  const c = PATCH_COLOURS[patch % PATCH_COLOURS.length];
+  const k = 0.45;
+  return (((c >> 16 & 255) * k) << 16) | (((c >> 8 & 255) * k) << 8) | ((c & 255) * k);
+}
+
+/** Move kinds (as Plan.moveKinds gives them) and how the path draws them. */
+export const KINDS = [
+  { name: 'feed', label: 'cutting (colour of its patch)', colour: null, dashed: false },
+  { name: 'link', label: 'link on the surface between cuts', colour: 0x111111, dashed: false },
+  { name: 'retract', label: 'retraction', colour: 0xd62728, dashed: true },
+  { name: 'rapid', label: 'rapid above the model', colour: 0xd62728, dashed: true },
+  { name: 'plunge', label: 'plunge onto the surface', colour: 0xff7f0e, dashed: false },
+];
+
+export const BACKGROUND = 0xeef1f5;
+export const EP_COLOUR = 0xffd400;
+export const CAGE_COLOUR = 0x303848;
+
+/** Heat-map colour of a value (mm): material left from 0 (blue) to the requested scallop
+ * (yellow), more than requested red, gouges magenta, never reached grey. */
+export function heatColour(v, scallopMm) {
+  if (!Number.isFinite(v)) return 0x9a9a9a;
+  if (v < 0) return 0xd01bd0;
+  const t = v / scallopMm;
+  if (t > 1) return 0xd62728;
+  // blue (0) -> cyan (1/3) -> green (2/3) -> yellow (1)
+  const stops = [[0x2c, 0x5b, 0xd6], [0x2c, 0xc0, 0xd0], [0x3c, 0xb0, 0x4a], [0xf2, 0xd0, 0x2a]];
+  const x = Math.min(1, Math.max(0, t)) * 3;
+  const i = Math.min(2, Math.floor(x));
+  const f = x - i;
+  const c = stops[i].map((a, k) => Math.round(a + (stops[i + 1][k] - a) * f));
+  return (c[0] << 16) | (c[1] << 8) | c[2];
+}
+
+export const hexCss = (c) => `#${c.toString(16).padStart(6, '0')}`;

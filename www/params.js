@@ -1,0 +1,127 @@
+// The planner's parameters: one table that gives each its form control, label and unit, its
+// name in the URL and as an attribute of <tspath-planner>, its PlanOptions field, its range
+// and default, and the checks across fields. Lengths in mm, angles in degrees.
+
+/**
+ * `key`: URL/attribute name; `field`: PlanOptions field (snake_case) or null for page-only
+ * settings; `kind`: number | patch | choice; `default`: value when absent (null = the
+ * engine's own default, said by `auto`).
+ */
+export const PARAMS = [
+  // Tool
+  { key: 'tool-radius', field: 'tool_radius_mm', group: 'tool', label: 'Ball-end radius', unit: 'mm', kind: 'number', min: 0.05, max: 25, step: 0.05, default: 0.5 },
+  { key: 'shank-radius', field: 'shank_radius_mm', group: 'tool', label: 'Shank radius', unit: 'mm', kind: 'number', min: 0.05, max: 50, step: 0.05, default: null, auto: 'ball radius' },
+  { key: 'flute-length', field: 'flute_length_mm', group: 'tool', label: 'Flute length', unit: 'mm', kind: 'number', min: 0, max: 200, step: 0.5, default: null, auto: '4 ball radii' },
+  { key: 'shank-length', field: 'shank_length_mm', group: 'tool', label: 'Shank length (ball centre to holder)', unit: 'mm', kind: 'number', min: 0.5, max: 300, step: 1, default: 20 },
+  { key: 'holder-radius', field: 'holder_radius_mm', group: 'tool', label: 'Holder radius', unit: 'mm', kind: 'number', min: 0.5, max: 200, step: 0.5, default: 10 },
+  { key: 'holder-length', field: 'holder_length_mm', group: 'tool', label: 'Holder length', unit: 'mm', kind: 'number', min: 0.5, max: 500, step: 1, default: 40 },
+  // Accuracy
+  { key: 'scallop', field: 'scallop_mm', group: 'accuracy', label: 'Scallop height', unit: 'mm', kind: 'number', min: 0.0005, max: 2, step: 0.001, default: 0.01 },
+  { key: 'chordal', field: 'chordal_mm', group: 'accuracy', label: 'Chordal tolerance', unit: 'mm', kind: 'number', min: 0.0001, max: 1, step: 0.001, default: 0.005 },
+  // Tool axis (five-axis machines only)
+  { key: 'max-tilt', field: 'max_tilt_deg', group: 'axis', label: 'Largest tilt to clear the holder', unit: '°', kind: 'number', min: 0, max: 90, step: 1, default: 60, fiveAxis: true },
+  { key: 'lead', field: 'lead_deg', group: 'axis', label: 'Lead angle', unit: '°', kind: 'number', min: -79, max: 79, step: 1, default: 0, fiveAxis: true },
+  { key: 'tilt', field: 'tilt_deg', group: 'axis', label: 'Tilt angle', unit: '°', kind: 'number', min: -79, max: 79, step: 1, default: 0, fiveAxis: true },
+  // Order
+  { key: 'start-patch', field: 'start_patch', group: 'order', label: 'Start patch', kind: 'patch', default: null, auto: 'patch 0' },
+  { key: 'finish-patch', field: 'finish_patch', group: 'order', label: 'Finish patch', kind: 'patch', default: null, auto: 'shortest order' },
+  { key: 'crossfeed', field: 'crossfeed', group: 'order', label: 'Pass direction', kind: 'choice', choices: [['', 'auto (fewer, longer passes)'], ['U', 'passes along v (u = const)'], ['V', 'passes along u (v = const)']], default: '' },
+  // Feeds
+  { key: 'feed', field: 'feed_mm_min', group: 'feeds', label: 'Cutting feed', unit: 'mm/min', kind: 'number', min: 1, max: 100000, step: 50, default: 1000 },
+  { key: 'plunge-feed', field: 'plunge_feed_mm_min', group: 'feeds', label: 'Plunge feed', unit: 'mm/min', kind: 'number', min: 1, max: 100000, step: 50, default: 300 },
+  { key: 'spindle', field: 'spindle_rpm', group: 'feeds', label: 'Spindle speed', unit: 'rpm', kind: 'number', min: 1, max: 100000, step: 500, default: 12000 },
+  { key: 'clearance', field: 'clearance_mm', group: 'feeds', label: 'Clearance above the model', unit: 'mm', kind: 'number', min: 0.1, max: 500, step: 1, default: 5 },
+  // Output (not plan options: they choose the program written from the plan)
+  { key: 'machine', field: null, group: 'output', label: 'Machine', kind: 'choice', choices: [], default: '3-axis' },
+  { key: 'dialect', field: null, group: 'output', label: 'G-code dialect', kind: 'choice', choices: [], default: 'linuxcnc' },
+  { key: 'units', field: null, group: 'output', label: 'Program units', kind: 'choice', choices: [['mm', 'millimetres (G21)'], ['inch', 'inches (G20)']], default: 'mm' },
+  // Simulation
+  { key: 'samples', field: null, group: 'sim', label: 'Simulation samples', unit: 'points', kind: 'number', min: 10000, max: 20000000, step: 10000, default: 1000000, integer: true },
+];
+
+export const GROUPS = [
+  ['accuracy', 'Accuracy'],
+  ['tool', 'Tool, shank and holder'],
+  ['output', 'Machine and program'],
+  ['axis', 'Tool axis (five-axis machines)'],
+  ['order', 'Patch order'],
+  ['feeds', 'Feeds and clearance'],
+  ['sim', 'Cutting simulation'],
+];
+
+export const byKey = Object.fromEntries(PARAMS.map((p) => [p.key, p]));
+
+/**
+ * Checks raw values (strings from controls, URL or attributes, keyed by `key`) and returns
+ * `{values, errors}`: numbers parsed (null where `auto`), and per key a message saying what
+ * is wrong. `patches` is the model's patch count, `fiveAxis` whether the machine tilts.
+ */
+export function validate(raw, { patches = 1, fiveAxis = false } = {}) {
+  const values = {};
+  const errors = {};
+  for (const p of PARAMS) {
+    const s = raw[p.key] === undefined || raw[p.key] === null ? '' : String(raw[p.key]).trim();
+    if (p.kind === 'number') {
+      if (s === '') {
+        if (p.default === null) values[p.key] = null;
+        else errors[p.key] = `${p.label} is required (${p.unit})`;
+        continue;
+      }
+      const v = Number(s);
+      if (!Number.isFinite(v)) {
+        errors[p.key] = `${p.label}: “${s}” is not a number`;
+      } else if (v < p.min || v > p.max) {
+        errors[p.key] = `${p.label} must be between ${p.min} and ${p.max} ${p.unit}`;
+      } else if (p.integer && !Number.isInteger(v)) {
+        errors[p.key] = `${p.label} must be a whole number`;
+      } else {
+        values[p.key] = v;
+      }
+    } else if (p.kind === 'patch') {
+      if (s === '') values[p.key] = null;
+      else {
+        const v = Number(s);
+        if (!Number.isInteger(v) || v < 0 || v >= patches) errors[p.key] = `${p.label} must be a patch from 0 to ${patches - 1}`;
+        else values[p.key] = v;
+      }
+    } else {
+      values[p.key] = s === '' ? p.default : s;
+    }
+  }
+  const v = values;
+  const fine = (...keys) => keys.every((k) => !(k in errors));
+  if (fine('scallop', 'tool-radius') && v.scallop >= v['tool-radius']) {
+    errors.scallop = `Scallop height must be smaller than the ball-end radius (${v['tool-radius']} mm)`;
+  }
+  const shank = v['shank-radius'] ?? v['tool-radius'];
+  if (fine('holder-radius', 'shank-radius', 'tool-radius') && v['holder-radius'] < shank) {
+    errors['holder-radius'] = `Holder radius must be at least the shank radius (${shank} mm)`;
+  }
+  const flute = v['flute-length'] ?? 4 * v['tool-radius'];
+  if (fine('flute-length', 'shank-length', 'tool-radius') && flute >= v['shank-length']) {
+    errors['flute-length'] = `Flute length (${flute} mm) must be shorter than the shank length (${v['shank-length']} mm)`;
+  }
+  if (!fiveAxis) {
+    for (const k of ['lead', 'tilt']) {
+      if (fine(k) && v[k] !== 0) errors[k] = `${byKey[k].label} needs a five-axis machine`;
+    }
+  }
+  return { values, errors };
+}
+
+/** PlanOptions for the engine from validated values (a three-axis machine keeps +Z). */
+export function planOptions(values, { fiveAxis }) {
+  const o = {};
+  for (const p of PARAMS) {
+    if (!p.field) continue;
+    const v = values[p.key];
+    if (v === null || v === '' || v === undefined) continue;
+    o[p.field] = v;
+  }
+  if (!fiveAxis) {
+    o.max_tilt_deg = 0;
+    o.lead_deg = 0;
+    o.tilt_deg = 0;
+  }
+  return o;
+}

@@ -1,0 +1,335 @@
+// The 3D view with three.js (vendored in www/vendor/): shaded surface with patches in
+// colours (or the scallop heat map), extraordinary points, optional control mesh, the tool
+// path by patch with links and retractions drawn apart, and the tool (ball, shank, holder).
+// Z is up; lengths are millimetres. Renders on demand, not in a loop.
+import * as THREE from './vendor/three.module.js';
+import { OrbitControls } from './vendor/OrbitControls.js';
+import {
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, KINDS, PATCH_COLOURS, heatColour, pathColour,
+} from './colours.js';
+
+const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
+
+export class View3D {
+  constructor(canvas) {
+    this.kind = 'webgl';
+    this.canvas = canvas;
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
+    this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+    this.renderer.setClearColor(BACKGROUND, 1);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(35, 1, 0.1, 1000);
+    this.camera.up.set(0, 0, 1);
+    this.scene.add(this.camera);
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x707880, 1.6));
+    const key = new THREE.DirectionalLight(0xffffff, 1.6);
+    key.position.set(0.4, 0.6, 1);
+    this.camera.add(key); // the light follows the viewer
+    this.controls = new OrbitControls(this.camera, canvas);
+    this.controls.screenSpacePanning = true;
+    this.controls.addEventListener('change', () => this.render());
+    this.layers = { surface: true, path: true, tool: true, cage: false, eps: true };
+    this.groups = {};
+    for (const k of Object.keys(this.layers)) {
+      this.groups[k] = new THREE.Group();
+      this.scene.add(this.groups[k]);
+    }
+    this.heat = null;
+    this.model = null;
+    this.#bindKeys();
+    this.resizer = new ResizeObserver(() => this.resize());
+    this.resizer.observe(canvas);
+    this.resize();
+  }
+
+  resize() {
+    const w = Math.max(1, this.canvas.clientWidth);
+    const h = Math.max(1, this.canvas.clientHeight);
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.render();
+  }
+
+  /** Draws on the next frame (coalesced). */
+  render() {
+    if (this.frame) return;
+    this.frame = requestAnimationFrame(() => {
+      this.frame = 0;
+      this.renderNow();
+    });
+  }
+
+  renderNow() {
+    for (const [k, on] of Object.entries(this.layers)) this.groups[k].visible = on;
+    this.renderer.render(this.scene, this.camera);
+  }
+
+  #clear(group) {
+    for (const o of [...group.children]) {
+      group.remove(o);
+      o.traverse((x) => {
+        if (x.geometry) x.geometry.dispose();
+        if (x.material) x.material.dispose();
+      });
+    }
+  }
+
+  /** The surface: `positions`/`normals` (Float32Array, xyz per vertex), `indices`
+   * (Uint32Array, 3 per triangle), `patchIds` (per triangle), `eps` (Float64Array xyz per
+   * extraordinary point), `cage` (Float64Array, xyz xyz per control-mesh edge). */
+  setModel(m) {
+    this.model = m;
+    this.heat = null;
+    for (const g of Object.values(this.groups)) this.#clear(g);
+    const { positions: p, normals: n, indices: idx, patchIds } = m;
+    // Unshared corners, so each triangle takes its patch's colour.
+    const nc = idx.length;
+    const pos = new Float32Array(3 * nc);
+    const nor = new Float32Array(3 * nc);
+    for (let c = 0; c < nc; c++) {
+      const v = idx[c];
+      for (let k = 0; k < 3; k++) {
+        pos[3 * c + k] = p[3 * v + k];
+        nor[3 * c + k] = n[3 * v + k];
+      }
+    }
+    const geom = new THREE.BufferGeometry();
+    geom.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+    geom.setAttribute('normal', new THREE.BufferAttribute(nor, 3));
+    geom.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * nc), 3));
+    geom.computeBoundingSphere();
+    const mat = new THREE.MeshPhongMaterial({
+      vertexColors: true, side: THREE.DoubleSide, shininess: 25,
+      polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+    });
+    this.surface = new THREE.Mesh(geom, mat);
+    this.groups.surface.add(this.surface);
+    this.#colourSurface();
+
+    const size = geom.boundingSphere.radius;
+    this.sceneRadius = size;
+    const nep = m.eps.length / 3;
+    if (nep > 0) {
+      const ball = new THREE.SphereGeometry(Math.max(size * 0.012, 1e-3), 16, 12);
+      const inst = new THREE.InstancedMesh(ball, new THREE.MeshPhongMaterial({ color: EP_COLOUR }), nep);
+      const mx = new THREE.Matrix4();
+      for (let i = 0; i < nep; i++) {
+        inst.setMatrixAt(i, mx.makeTranslation(m.eps[3 * i], m.eps[3 * i + 1], m.eps[3 * i + 2]));
+      }
+      this.groups.eps.add(inst);
+    }
+    if (m.cage.length) {
+      const cg = new THREE.BufferGeometry();
+      cg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(m.cage), 3));
+      this.groups.cage.add(new THREE.LineSegments(cg, new THREE.LineBasicMaterial({ color: CAGE_COLOUR })));
+      const pts = new THREE.Points(cg, new THREE.PointsMaterial({ color: CAGE_COLOUR, size: 4, sizeAttenuation: false }));
+      this.groups.cage.add(pts);
+    }
+    this.fit();
+  }
+
+  #colourSurface() {
+    if (!this.surface) return;
+    const { indices: idx, patchIds } = this.model;
+    const col = this.surface.geometry.getAttribute('color');
+    const c = new THREE.Color();
+    for (let corner = 0; corner < idx.length; corner++) {
+      const hex = this.heat
+        ? heatColour(this.heat.values[idx[corner]], this.heat.scallopMm)
+        : PATCH_COLOURS[patchIds[(corner / 3) | 0] % PATCH_COLOURS.length];
+      c.setHex(hex);
+      col.setXYZ(corner, c.r, c.g, c.b);
+    }
+    col.needsUpdate = true;
+    this.render();
+  }
+
+  /** The scallop heat map (one value per tessellation vertex, mm) or null for patches. */
+  setHeat(values, scallopMm) {
+    this.heat = values ? { values, scallopMm } : null;
+    this.#colourSurface();
+  }
+
+  /** The path: `cl` (Float64Array, ball centres), `kinds` (Uint8Array), `patchIds`. */
+  setPath(path) {
+    this.#clear(this.groups.path);
+    if (!path) {
+      this.render();
+      return;
+    }
+    const { cl, kinds, patchIds } = path;
+    const n = kinds.length;
+    // Segment i runs from move i-1 to move i and is of move i's kind.
+    const count = new Array(KINDS.length).fill(0);
+    for (let i = 1; i < n; i++) count[kinds[i]]++;
+    const c = new THREE.Color();
+    KINDS.forEach((kind, k) => {
+      if (!count[k]) return;
+      const pos = new Float32Array(6 * count[k]);
+      const col = kind.colour === null ? new Float32Array(6 * count[k]) : null;
+      let s = 0;
+      for (let i = 1; i < n; i++) {
+        if (kinds[i] !== k) continue;
+        for (let e = 0; e < 2; e++) {
+          const j = 3 * (i - 1 + e);
+          pos.set([cl[j], cl[j + 1], cl[j + 2]], 6 * s + 3 * e);
+          if (col) {
+            c.setHex(pathColour(patchIds[i]));
+            col.set([c.r, c.g, c.b], 6 * s + 3 * e);
+          }
+        }
+        s++;
+      }
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+      let mat;
+      if (col) {
+        g.setAttribute('color', new THREE.BufferAttribute(col, 3));
+        // Dense finishing paths cover the surface line by line: let it show through.
+        mat = new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.6 });
+      } else if (kind.dashed) {
+        const dash = Math.max(this.sceneRadius || 1, 1e-3) * 0.02;
+        mat = new THREE.LineDashedMaterial({ color: kind.colour, dashSize: dash, gapSize: dash });
+      } else {
+        mat = new THREE.LineBasicMaterial({ color: kind.colour });
+      }
+      const lines = new THREE.LineSegments(g, mat);
+      if (kind.dashed) lines.computeLineDistances();
+      lines.name = kind.name;
+      this.groups.path.add(lines);
+    });
+    this.render();
+  }
+
+  /** The tool at a pose: `centre` (ball centre), `axis` (unit, tip to spindle) and the
+   * tool's sizes (mm): `radius`, `shankRadius`, `fluteLength`, `shankLength`,
+   * `holderRadius`, `holderLength`. null hides it. */
+  setTool(t) {
+    if (!t) {
+      this.#clear(this.groups.tool);
+      this.toolKey = null;
+      this.render();
+      return;
+    }
+    const key = [t.radius, t.shankRadius, t.fluteLength, t.shankLength, t.holderRadius, t.holderLength].join();
+    if (key !== this.toolKey) {
+      this.#clear(this.groups.tool);
+      this.toolKey = key;
+      const steel = new THREE.MeshPhongMaterial({ color: 0xb8bec8, shininess: 80 });
+      const flutes = new THREE.MeshPhongMaterial({ color: 0x8a93a3, shininess: 60 });
+      const holder = new THREE.MeshPhongMaterial({ color: 0x4a5568, transparent: true, opacity: 0.35, depthWrite: false });
+      const tool = new THREE.Group();
+      tool.add(new THREE.Mesh(new THREE.SphereGeometry(t.radius, 32, 16), flutes));
+      const cyl = (r, from, to, mat) => {
+        if (to <= from) return;
+        const m = new THREE.Mesh(new THREE.CylinderGeometry(r, r, to - from, 32, 1, true), mat);
+        m.position.y = (from + to) / 2;
+        tool.add(m);
+      };
+      cyl(t.radius, 0, t.fluteLength, flutes);
+      cyl(t.shankRadius, t.fluteLength, t.shankLength, steel);
+      cyl(t.holderRadius, t.shankLength, t.shankLength + t.holderLength, holder);
+      this.groups.tool.add(tool);
+      this.tool = tool;
+    }
+    this.tool.position.set(...t.centre);
+    this.tool.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), new THREE.Vector3(...t.axis).normalize());
+    this.render();
+  }
+
+  /** Shows or hides layers: `{surface, path, tool, cage, eps}`. */
+  setLayers(layers) {
+    Object.assign(this.layers, layers);
+    this.render();
+  }
+
+  /** Centres the model and frames it. */
+  fit() {
+    if (!this.surface) return;
+    const s = this.surface.geometry.boundingSphere;
+    const dir = new THREE.Vector3(-0.6, -1, 1.1).normalize();
+    const dist = s.radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 1.05;
+    this.controls.target.copy(s.center);
+    this.camera.position.copy(s.center).addScaledVector(dir, dist);
+    this.camera.near = Math.max(dist / 1000, 1e-4);
+    this.camera.far = dist * 100;
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+    this.render();
+  }
+
+  /** Renders now and returns the frame's pixels, RGBA rows (for tests and diagnostics). */
+  snapshot() {
+    this.renderNow();
+    const gl = this.renderer.getContext();
+    const w = gl.drawingBufferWidth;
+    const h = gl.drawingBufferHeight;
+    const px = new Uint8Array(4 * w * h);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    return px;
+  }
+
+  /** Renders now and counts pixels that are not background. */
+  countPixels() {
+    const px = this.snapshot();
+    const w = this.renderer.getContext().drawingBufferWidth;
+    const h = this.renderer.getContext().drawingBufferHeight;
+    const bg = [BACKGROUND >> 16 & 255, BACKGROUND >> 8 & 255, BACKGROUND & 255];
+    let drawn = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      if (Math.abs(px[i] - bg[0]) + Math.abs(px[i + 1] - bg[1]) + Math.abs(px[i + 2] - bg[2]) > 24) drawn++;
+    }
+    return { drawn, total: w * h };
+  }
+
+  /** Arrow keys orbit, Shift+arrows pan, + and - zoom, F fits. */
+  #bindKeys() {
+    this.canvas.addEventListener('keydown', (e) => {
+      const cam = this.camera;
+      const target = this.controls.target;
+      const offset = cam.position.clone().sub(target);
+      const right = new THREE.Vector3().crossVectors(cam.up, offset).normalize(); // screen right
+      const turn = (axis, angle) => {
+        offset.applyQuaternion(new THREE.Quaternion().setFromAxisAngle(axis, angle));
+      };
+      const pan = (dx, dy) => {
+        const step = offset.length() * 0.05;
+        const up = new THREE.Vector3().crossVectors(offset, right).normalize(); // screen up
+        const d = right.multiplyScalar(dx * step).add(up.multiplyScalar(dy * step));
+        target.add(d);
+        cam.position.add(d);
+      };
+      const arrows = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, 1], ArrowDown: [0, -1] };
+      if (arrows[e.key]) {
+        const [dx, dy] = arrows[e.key];
+        if (e.shiftKey) pan(dx, dy);
+        else {
+          if (dx) turn(new THREE.Vector3(0, 0, 1), -dx * ORBIT_STEP_RAD);
+          if (dy) {
+            const next = offset.clone().applyQuaternion(new THREE.Quaternion().setFromAxisAngle(right, -dy * ORBIT_STEP_RAD));
+            if (Math.abs(next.clone().normalize().z) < 0.995) offset.copy(next);
+          }
+          cam.position.copy(target).add(offset);
+        }
+      } else if (e.key === '+' || e.key === '=') {
+        cam.position.copy(target).addScaledVector(offset, 1 / 1.15);
+      } else if (e.key === '-' || e.key === '_') {
+        cam.position.copy(target).addScaledVector(offset, 1.15);
+      } else if (e.key === 'f' || e.key === 'F') {
+        this.fit();
+      } else {
+        return;
+      }
+      e.preventDefault();
+      this.controls.update();
+      this.render();
+    });
+  }
+
+  dispose() {
+    this.resizer.disconnect();
+    this.controls.dispose();
+    this.renderer.dispose();
+  }
+}

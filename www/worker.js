@@ -1,0 +1,153 @@
+// The Web Worker that owns the wasm engine and does every heavy step (load, tessellate,
+// plan, post, verify, export), so the page's thread only draws and answers the user.
+//
+// Protocol: the page posts {id, op, args}; the worker answers {id, ok: true, result} or
+// {id, ok: false, error}, and while planning posts {id, progress} (fraction done). Large
+// arrays travel as transferred typed arrays. A request cannot be interrupted once running:
+// the page cancels by terminating this worker and starting a new one (see client.js).
+import { engineInfo, loadBytes, loadSample } from './engine.js';
+
+const KIND_NAMES = ['feed', 'link', 'retract', 'rapid', 'plunge'];
+/** Least progress interval posted to the page (ms): enough for a smooth bar. */
+const PROGRESS_INTERVAL_MS = 40;
+
+let model = null; // wasm Model
+let mesh = null; // wasm SurfaceMesh of `model` (the drawn one; the heat map is per vertex of it)
+let plan = null; // wasm Plan of `model`
+
+function free(x) {
+  if (x) x.free();
+  return null;
+}
+
+/** Tessellation tolerance for drawing: 1/5000 of the diagonal, at least 5 µm (mm). */
+function drawChordal(summary) {
+  const { min, max } = summary.bbox_mm;
+  return Math.max(0.005, Math.hypot(max[0] - min[0], max[1] - min[1], max[2] - min[2]) * 2e-4);
+}
+
+const ops = {
+  async init() {
+    return { result: await engineInfo() };
+  },
+
+  /** Loads a sample ({sample}) or file bytes ({bytes, name}); the old model stays on failure. */
+  async load(source) {
+    const next = source.sample !== undefined
+      ? await loadSample(source.sample)
+      : await loadBytes(new Uint8Array(source.bytes), source.name);
+    let nextMesh = null;
+    try {
+      const summary = next.summary();
+      const chordal = drawChordal(summary);
+      nextMesh = next.tessellate(chordal);
+      const result = {
+        summary,
+        chordal_mm: chordal,
+        positions: nextMesh.positions(),
+        normals: nextMesh.normals(),
+        indices: nextMesh.indices(),
+        patchIds: nextMesh.patchIds(),
+        eps: next.extraordinaryPoints(),
+        cage: next.controlEdges(),
+      };
+      plan = free(plan);
+      mesh = free(mesh);
+      model = free(model);
+      model = next;
+      mesh = nextMesh;
+      const transfer = ['positions', 'normals', 'indices', 'patchIds', 'eps', 'cage'].map((k) => result[k].buffer);
+      return { result, transfer };
+    } catch (e) {
+      free(nextMesh);
+      next.free();
+      throw e;
+    }
+  },
+
+  /** Plans with `options` (PlanOptions fields), reporting progress under request `id`. */
+  async plan(options, id) {
+    if (!model) throw new Error('no model is loaded');
+    plan = free(plan);
+    let last = 0;
+    const progress = (f) => {
+      const now = performance.now();
+      if (now - last >= PROGRESS_INTERVAL_MS || f >= 1) {
+        last = now;
+        postMessage({ id, progress: f });
+      }
+      return true;
+    };
+    plan = model.plan(options, progress);
+    const result = {
+      report: plan.report(),
+      cl: plan.clPoints(),
+      cc: plan.ccPoints(),
+      axes: plan.axes(),
+      kinds: plan.moveKinds(),
+      patchIds: plan.patchIds(),
+    };
+    const transfer = ['cl', 'cc', 'axes', 'kinds', 'patchIds'].map((k) => result[k].buffer);
+    return { result, transfer };
+  },
+
+  /** The program for a machine, dialect and units, and the line of each move in it. */
+  async post(machine, dialect, units) {
+    if (!plan) throw new Error('nothing is planned');
+    const text = plan.gcodeFor(machine, dialect, units);
+    const lines = plan.gcodeLines(machine, dialect, units);
+    return { result: { text, lines }, transfer: [lines.buffer] };
+  },
+
+  /** Cutting simulation of the plan: summary and the heat map per drawn vertex. */
+  async verify(options) {
+    if (!plan) throw new Error('nothing is planned');
+    const v = model.verify(plan, mesh, options);
+    try {
+      const result = { summary: v.summary(), heat: v.heatMap(), verify_ms: v.verifyMs };
+      return { result, transfer: [result.heat.buffer] };
+    } finally {
+      v.free();
+    }
+  },
+
+  /** The drawn surface as binary STL bytes. */
+  async stl() {
+    if (!mesh) throw new Error('no model is loaded');
+    const bytes = mesh.stl(model.name);
+    return { result: bytes, transfer: [bytes.buffer] };
+  },
+
+  /** CL data as CSV: one row per move, ball centre, tool axis and contact point (mm). */
+  async csv() {
+    if (!plan) throw new Error('nothing is planned');
+    const cl = plan.clPoints();
+    const cc = plan.ccPoints();
+    const ax = plan.axes();
+    const kinds = plan.moveKinds();
+    const patches = plan.patchIds();
+    const f = (x) => x.toFixed(6);
+    const rows = ['move,kind,patch,cl_x_mm,cl_y_mm,cl_z_mm,axis_i,axis_j,axis_k,cc_x_mm,cc_y_mm,cc_z_mm'];
+    for (let i = 0; i < kinds.length; i++) {
+      const k = 3 * i;
+      rows.push([
+        i, KIND_NAMES[kinds[i]] ?? kinds[i], patches[i],
+        f(cl[k]), f(cl[k + 1]), f(cl[k + 2]),
+        f(ax[k]), f(ax[k + 1]), f(ax[k + 2]),
+        f(cc[k]), f(cc[k + 1]), f(cc[k + 2]),
+      ].join(','));
+    }
+    return { result: rows.join('\n') + '\n' };
+  },
+};
+
+self.onmessage = async (e) => {
+  const { id, op, args } = e.data;
+  try {
+    if (!ops[op]) throw new Error(`unknown request ${op}`);
+    const { result, transfer = [] } = await ops[op](...(args || []), id);
+    postMessage({ id, ok: true, result }, transfer);
+  } catch (err) {
+    postMessage({ id, ok: false, error: err && err.message ? err.message : String(err) });
+  }
+};
