@@ -325,6 +325,23 @@ test('heat map overlay from the cutting simulation', async (page, url) => {
   return `heat map recolours ${changed} px; re-planned on change to ${cl} CL points`;
 });
 
+test('a planning error is shown with its reason and the page stays usable', async (page, url) => {
+  await page.goto(`${url}?model=keycap-concave&tool-radius=1&scallop=0.03`);
+  await waitState(page, 'model-loaded');
+  check(await host(page, (el) => el.layerPixels('eps')) > 0, 'extraordinary points are marked');
+  check(await host(page, (el) => el.layerPixels('cage')) > 500, 'the control mesh can be shown');
+  await page.click('#plan');
+  await page.waitForSelector('#status.error', { state: 'attached' });
+  const msg = await page.textContent('#status');
+  check(/Could not plan/.test(msg) && /smaller than the tool radius 1 mm/.test(msg), `planner error shown: ${msg}`);
+  check(await attr(page, 'data-state') === 'model-loaded', 'back to the loaded model');
+  await page.screenshot({ path: join(shots, 'plan-error.png') });
+  await setParam(page, 'tool-radius', 0.5);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  return `“${msg.trim().slice(0, 120)}…”`;
+});
+
 test('a malformed file shows an error and the previous model stays usable', async (page, url) => {
   await page.goto(`${url}?model=keycap-convex`);
   await waitState(page, 'model-loaded');
