@@ -392,18 +392,16 @@ fn edge_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
-}
-
 /// How far (in sides of the rectangles) one loop may run ahead of the other before the
 /// zipper must advance the one behind, whatever the edge lengths say.
 const STEP_SLACK: f64 = 1e-9;
 
-/// Triangulates the band between a closed outer loop and a closed inner loop, both
-/// counter-clockwise, by walking both in step around the square.
 /// A closed loop: vertex ids, parameters, and positions around its rectangle (0..4,
 /// increasing, starting at the lower-left corner).
 type Loop<'a> = (&'a [u32], &'a [(f64, f64)], &'a [f64]);
 
+/// Triangulates the band between a closed outer loop and a closed inner loop, both
+/// counter-clockwise, by walking both in step around the square.
 fn zip(
     outer: Loop,
     inner: Loop,
