@@ -466,3 +466,29 @@ fn tool_axis_clears_shank_and_holder_and_is_vertical_where_it_can_be() {
     assert!(tilted > 0, "the fat shank needs tilting near the walls");
     assert_eq!(report.retractions, 0);
 }
+
+#[test]
+fn lead_and_tilt_incline_the_axis_from_the_normal() {
+    let m = samples::load_sample("dome").unwrap();
+    for (lead, tilt) in [(10.0f64, 0.0f64), (0.0, 15.0), (5.0, 5.0)] {
+        let opts = PlanOptions::default()
+            .with_tool_radius(2.0)
+            .with_scallop(0.05)
+            .with_lead_tilt(lead, tilt);
+        let path = isoparametric::plan_zigzag(&m, &opts, &mut |_| true).unwrap();
+        // Angle between axis and normal: lead and tilt are rotations about perpendicular
+        // axes, so cos = cos(lead)·cos(tilt).
+        let want = (lead.to_radians().cos() * tilt.to_radians().cos()).acos();
+        let mut n = 0;
+        for mv in path.moves.iter().filter(|mv| mv.kind == MoveKind::Feed) {
+            let normal = (mv.cl_point - mv.cc_point).normalize();
+            let got = mv.tool_axis.dot(&normal).clamp(-1.0, 1.0).acos();
+            assert!(
+                (got - want).abs() < 1e-9,
+                "lead {lead} tilt {tilt}: {got} vs {want}"
+            );
+            n += 1;
+        }
+        assert!(n > 100);
+    }
+}

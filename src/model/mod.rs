@@ -83,12 +83,7 @@ impl Model {
                         } else {
                             face.height
                         };
-                    let (u, v) = match e.side {
-                        0 => (s, 0.0),
-                        1 => (1.0, s),
-                        2 => (1.0 - s, 1.0),
-                        _ => (0.0, 1.0 - s),
-                    };
+                    let (u, v) = crate::surface::on_side(e.side, s);
                     Some(self.surface.subs(fi, u, v))
                 })
             })

@@ -17,7 +17,6 @@ use super::PlanOptions;
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
 use crate::model::Model;
-use std::collections::HashMap;
 
 /// Azimuths tried around +Z when the usual ones fail.
 const AZIMUTHS: usize = 12;
@@ -33,7 +32,12 @@ const SIDE_AZIMUTH: f64 = std::f64::consts::FRAC_PI_6;
 pub struct Obstacles {
     points: Vec<Point3>,
     cell: f64,
-    grid: HashMap<(i32, i32, i32), Vec<u32>>,
+    /// Samples sorted by grid cell: those of cell `k` are `sorted[start[k]..start[k + 1]]`.
+    sorted: Vec<Point3>,
+    start: Vec<u32>,
+    /// Grid origin and size in cells.
+    origin: [f64; 3],
+    dims: [usize; 3],
     /// Highest sample per column of the grid, dense over the model's x–y extent, at the
     /// grid's cell size and at [`COARSE`] times it.
     heights: HeightMap,
@@ -87,19 +91,41 @@ impl Obstacles {
         // and the surface within the chordal tolerance of the triangle.
         let gap_mm = 0.58 * worst + chordal;
         let cell = (size / GRID_CELLS).max(gap_mm);
-        let mut grid: HashMap<(i32, i32, i32), Vec<u32>> = HashMap::new();
-        let key = |x: f64| (x / cell).floor() as i32;
-        for (i, q) in points.iter().enumerate() {
-            grid.entry((key(q.x), key(q.y), key(q.z)))
-                .or_default()
-                .push(i as u32);
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for q in &points {
+            for k in 0..3 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        let dims = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).max(1));
+        let index = |q: &Point3| {
+            let c = [0, 1, 2].map(|k| (((q[k] - lo[k]) / cell) as usize).min(dims[k] - 1));
+            (c[2] * dims[1] + c[1]) * dims[0] + c[0]
+        };
+        let mut start = vec![0u32; dims[0] * dims[1] * dims[2] + 1];
+        for q in &points {
+            start[index(q) + 1] += 1;
+        }
+        for k in 1..start.len() {
+            start[k] += start[k - 1];
+        }
+        let mut fill = start.clone();
+        let mut sorted = vec![Point3::origin(); points.len()];
+        for q in &points {
+            let k = index(q);
+            sorted[fill[k] as usize] = *q;
+            fill[k] += 1;
         }
         let heights = HeightMap::new(&points, cell);
         let coarse = HeightMap::new(&points, cell * COARSE);
         Obstacles {
             points,
             cell,
-            grid,
+            sorted,
+            start,
+            origin: lo,
+            dims,
             heights,
             coarse,
             top: model.surface.bbox().max[2],
@@ -160,15 +186,25 @@ impl Obstacles {
         if cells > self.points.len() as f64 {
             return self.points.iter().find(test).copied();
         }
-        for i in self.key(lo[0])..=self.key(hi[0]) {
-            for j in self.key(lo[1])..=self.key(hi[1]) {
-                for k in self.key(lo[2])..=self.key(hi[2]) {
-                    if let Some(list) = self.grid.get(&(i, j, k)) {
-                        if let Some(p) = list.iter().map(|&pi| &self.points[pi as usize]).find(test)
-                        {
-                            return Some(*p);
-                        }
-                    }
+        // Cell ranges, clamped to the grid (samples outside it do not exist).
+        let range = |k: usize| -> Option<(usize, usize)> {
+            let a = ((lo[k] - self.origin[k]) / self.cell).floor();
+            let b = ((hi[k] - self.origin[k]) / self.cell).floor();
+            if b < 0.0 || a > (self.dims[k] - 1) as f64 {
+                return None;
+            }
+            Some((a.max(0.0) as usize, (b as usize).min(self.dims[k] - 1)))
+        };
+        let (rx, ry, rz) = (range(0)?, range(1)?, range(2)?);
+        for k in rz.0..=rz.1 {
+            for j in ry.0..=ry.1 {
+                let row = (k * self.dims[1] + j) * self.dims[0];
+                let (a, b) = (
+                    self.start[row + rx.0] as usize,
+                    self.start[row + rx.1 + 1] as usize,
+                );
+                if let Some(p) = self.sorted[a..b].iter().find(test) {
+                    return Some(*p);
                 }
             }
         }

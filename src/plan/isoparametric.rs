@@ -420,7 +420,10 @@ pub fn corner_ids(model: &Model) -> Vec<[u32; 4]> {
         .collect()
 }
 
-/// Travelling-salesman costs between the model's patches.
+/// Travelling-salesman costs between the model's patches: the layout's connections, and
+/// patches whose corners coincide in space (across a crease's zero-width faces the layout
+/// sees no shared edge, but the tool can pass): two shared corners make a boundary
+/// connection, one a corner connection.
 pub fn patch_costs(model: &Model) -> CostMatrix {
     let mut m = CostMatrix::new(model.layout.len());
     for c in &model.layout.connections {
@@ -429,6 +432,17 @@ pub fn patch_costs(model: &Model) -> CostMatrix {
             ConnectionKind::Corner => order::CORNER_COST,
         };
         m.connect(c.a as usize, c.b as usize, cost);
+    }
+    let ids = corner_ids(model);
+    for a in 0..ids.len() {
+        for b in a + 1..ids.len() {
+            let shared = ids[a].iter().filter(|x| ids[b].contains(x)).count();
+            match shared {
+                0 => {}
+                1 => m.connect(a, b, order::CORNER_COST),
+                _ => m.connect(a, b, order::BOUNDARY_COST),
+            }
+        }
     }
     m
 }
@@ -523,8 +537,8 @@ pub fn plan(
         .map(|f| f as usize)
         .filter(|&f| f != start || np == 1);
     let costs = patch_costs(model);
-    let order = order::patch_order(&costs, start, finish);
     let ids = corner_ids(model);
+    let order = order::patch_order(&costs, start, finish);
     let (transits, forced) = corners::select(&order, &ids, &preferred, None);
     let safe_z = model.surface.bbox().max[2] + 2.0 * r + opts.clearance_mm;
     let mut moves: Vec<Move> = Vec::new();

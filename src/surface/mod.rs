@@ -134,6 +134,17 @@ impl FaceSurface {
     }
 }
 
+/// Face parameters `(u, v)` at fraction `s` along side `side` (0..3: `v = 0` forwards,
+/// `u = 1` forwards, `v = 1` backwards, `u = 0` backwards), the direction half-edges run.
+pub fn on_side(side: u8, s: f64) -> (f64, f64) {
+    match side {
+        0 => (s, 0.0),
+        1 => (1.0, s),
+        2 => (1.0 - s, 1.0),
+        _ => (0.0, 1.0 - s),
+    }
+}
+
 /// Fractions of the way towards the face centre at which a normal is looked for when the
 /// surface is singular at the point asked (relative, dimensionless).
 const NORMAL_PROBES: [f64; 4] = [1e-9, 1e-7, 1e-5, 1e-3];

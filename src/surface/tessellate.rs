@@ -6,7 +6,7 @@
 //! for its own curvature and stitches the grid to its boundary samples with a strip. So no
 //! cracks open where faces of different sizes or T-junctions meet.
 
-use super::{FaceSurface, Surface};
+use super::{on_side, FaceSurface, Surface};
 use crate::geom::{Point3, Vector3};
 use crate::layout::PatchLayout;
 use crate::tmesh::TMesh;
@@ -392,26 +392,16 @@ fn edge_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
-/// `(u, v)` at fraction `s` along side `side` of a face.
-fn on_side(side: u8, s: f64) -> (f64, f64) {
-    match side {
-        0 => (s, 0.0),
-        1 => (1.0, s),
-        2 => (1.0 - s, 1.0),
-        _ => (0.0, 1.0 - s),
-    }
-}
-
 /// How far (in sides of the rectangles) one loop may run ahead of the other before the
 /// zipper must advance the one behind, whatever the edge lengths say.
 const STEP_SLACK: f64 = 1e-9;
 
-/// Triangulates the band between a closed outer loop and a closed inner loop, both
-/// counter-clockwise, by walking both in step around the square.
 /// A closed loop: vertex ids, parameters, and positions around its rectangle (0..4,
 /// increasing, starting at the lower-left corner).
 type Loop<'a> = (&'a [u32], &'a [(f64, f64)], &'a [f64]);
 
+/// Triangulates the band between a closed outer loop and a closed inner loop, both
+/// counter-clockwise, by walking both in step around the square.
 fn zip(
     outer: Loop,
     inner: Loop,
