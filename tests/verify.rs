@@ -416,7 +416,7 @@ const PLANNED: &[(&str, f64, f64, usize)] = &[
     ("waves", 0.5, 0.01, 2_500_000),
     ("bumps-hole", 0.5, 0.01, 2_000_000),
     // `head` is closed: from +Z its underside cannot be reached (the planner reports
-    // where the holder would hit it), so it has no place in this list.
+    // where the holder would hit it); it is planned five-axis below.
 ];
 
 #[test]
@@ -464,6 +464,56 @@ fn planned_paths_keep_their_scallop_and_do_not_gouge() {
         );
         assert!(v.max_gouge_mm <= opts.chordal_mm + v.gouge_error_bound_mm);
     }
+}
+
+/// The closed head, planned five-axis (tilts up to 90°: the underside is reached with the
+/// tool sideways), at the paper's h = 0.01 mm with r = 0.5 mm: every sample is reached,
+/// no scallop above h, and nothing cut below the surface, the retract after the last cut
+/// (which straight up would pass through the head above it) included.
+#[test]
+fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
+    let (r, h) = (0.5, 0.01);
+    let m = samples::load_sample("head").unwrap();
+    let mut opts = PlanOptions::default().with_tool_radius(r).with_scallop(h);
+    opts.max_tilt_deg = 90.0;
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+    let air = planned.axes.air;
+    assert_eq!(air.blocked, 0, "every retract and approach finds a way out");
+    assert!(
+        air.escaped >= 1,
+        "the last cut ends under the head's overhang: its retract backs out first"
+    );
+    let p = &planned.toolpath;
+    let v = verify::verify_to_bound(
+        &m.surface,
+        &CutterPath::from_toolpath(p).unwrap(),
+        &VerifyOptions::default()
+            .with_samples(7_000_000)
+            .with_scallop(h)
+            .with_gouge_tolerance(opts.chordal_mm),
+        0.15 * h,
+    )
+    .unwrap();
+    let report = planned.report(&opts);
+    println!(
+        "head five-axis r={r} h={h}: {} CL points, {} tilted, largest axis step {:.1}°; max scallop {:.6} mm (bound {:.2e}), p95 {:.6}, unreached {}, max gouge {:.6} mm (bound {:.2e}), gouged beyond chordal {}, {} samples",
+        report.cl_points,
+        planned.axes.tilted,
+        report.max_axis_step_deg,
+        v.max_scallop_mm,
+        v.scallop_error_bound_mm,
+        v.p95_scallop_mm,
+        v.unreached_samples,
+        v.max_gouge_mm,
+        v.gouge_error_bound_mm,
+        v.gouge_count,
+        v.samples
+    );
+    assert_eq!(v.unreached_samples, 0, "the whole head is cut");
+    assert!(v.max_scallop_mm <= h + v.scallop_error_bound_mm);
+    assert!(v.scallop_error_bound_mm < 0.2 * h);
+    assert_eq!(v.gouge_count, 0);
+    assert!(v.max_gouge_mm <= opts.chordal_mm + v.gouge_error_bound_mm);
 }
 
 #[test]

@@ -30,7 +30,6 @@ const SIDE_AZIMUTH: f64 = std::f64::consts::FRAC_PI_6;
 /// Dense samples of the model's surface in a uniform grid, with a height map for vertical
 /// axes.
 pub struct Obstacles {
-    points: Vec<Point3>,
     cell: f64,
     /// Samples sorted by grid cell: those of cell `k` are `sorted[start[k]..start[k + 1]]`.
     sorted: Vec<Point3>,
@@ -51,8 +50,9 @@ pub struct Obstacles {
 
 impl Obstacles {
     /// Samples the model for collision tests, no two neighbouring samples farther apart
-    /// than `spacing` (mm).
-    pub fn new(model: &Model, spacing: f64) -> Obstacles {
+    /// than `spacing` (mm), indexed in cells of about `cell_mm` (at most the model's size
+    /// over [`GRID_CELLS`], at least the sampling gap).
+    pub fn new(model: &Model, spacing: f64, cell_mm: f64) -> Obstacles {
         let size = model.surface.bbox().diagonal().max(1e-6);
         let chordal = (0.25 * spacing).max(size * 2e-4);
         let t = model.tessellate(chordal);
@@ -90,7 +90,7 @@ impl Obstacles {
         // Every point of a triangle is within 0.58 of the lattice spacing of a lattice point,
         // and the surface within the chordal tolerance of the triangle.
         let gap_mm = 0.58 * worst + chordal;
-        let cell = (size / GRID_CELLS).max(gap_mm);
+        let cell = cell_mm.min(size / GRID_CELLS).max(gap_mm);
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for q in &points {
             for k in 0..3 {
@@ -120,7 +120,6 @@ impl Obstacles {
         let heights = HeightMap::new(&points, cell);
         let coarse = HeightMap::new(&points, cell * COARSE);
         Obstacles {
-            points,
             cell,
             sorted,
             start,
@@ -131,10 +130,6 @@ impl Obstacles {
             top: model.surface.bbox().max[2],
             gap_mm,
         }
-    }
-
-    fn key(&self, x: f64) -> i32 {
-        (x / self.cell).floor() as i32
     }
 
     /// True if no sample within `radius` of `c` (in x–y) rises above `z`.
@@ -159,33 +154,48 @@ impl Obstacles {
     ) -> Option<Point3> {
         let g = self.gap_mm;
         let rad = rad + g;
-        let (p0, p1) = (c + axis * a0, c + axis * a1);
+        let (p0, p1) = (c + axis * (a0 - g), c + axis * (a1 + g));
         // Entirely above the model: nothing to hit.
         let lowest = p0.z.min(p1.z) - rad * (1.0 - axis.z * axis.z).max(0.0).sqrt();
         if lowest > self.top + g {
             return None;
         }
-        let lo = [
-            p0.x.min(p1.x) - rad,
-            p0.y.min(p1.y) - rad,
-            p0.z.min(p1.z) - rad,
-        ];
-        let hi = [
-            p0.x.max(p1.x) + rad,
-            p0.y.max(p1.y) + rad,
-            (p0.z.max(p1.z) + rad).min(self.top + g),
-        ];
-        let test = |q: &&Point3| {
-            let d = *q - c;
+        let test = |q: &Point3| {
+            let d = q - c;
             let axial = d.dot(axis);
             axial > a0 - g && axial < a1 + g && (d - axis * axial).norm() < rad
         };
-        let cells = ((self.key(hi[0]) - self.key(lo[0]) + 1) as f64)
-            * ((self.key(hi[1]) - self.key(lo[1]) + 1) as f64)
-            * ((self.key(hi[2]) - self.key(lo[2]) + 1) as f64);
-        if cells > self.points.len() as f64 {
-            return self.points.iter().find(test).copied();
-        }
+        self.find_near_segment(&p0, &p1, rad, test)
+    }
+
+    /// A sample closer than `rad` to the segment from `p0` to `p1` (the ball swept along it),
+    /// if there is one. Samples stand for the surface only to within the sampling gap, so a
+    /// touch shallower than that may go unseen.
+    pub fn capsule_hit(&self, p0: &Point3, p1: &Point3, rad: f64) -> Option<Point3> {
+        let d = p1 - p0;
+        let len2 = d.norm_squared();
+        let test = |q: &Point3| {
+            let t = if len2 > 0.0 {
+                ((q - p0).dot(&d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (p0 + d * t - q).norm() < rad
+        };
+        self.find_near_segment(p0, p1, rad, test)
+    }
+
+    /// The first sample passing `test` among those of the grid cells that come within
+    /// `rad` of the segment from `p0` to `p1` (every sample passing `test` must lie there).
+    fn find_near_segment(
+        &self,
+        p0: &Point3,
+        p1: &Point3,
+        rad: f64,
+        test: impl Fn(&Point3) -> bool,
+    ) -> Option<Point3> {
+        let lo = [0, 1, 2].map(|k| p0[k].min(p1[k]) - rad);
+        let hi = [0, 1, 2].map(|k| p0[k].max(p1[k]) + rad);
         // Cell ranges, clamped to the grid (samples outside it do not exist).
         let range = |k: usize| -> Option<(usize, usize)> {
             let a = ((lo[k] - self.origin[k]) / self.cell).floor();
@@ -196,19 +206,88 @@ impl Obstacles {
             Some((a.max(0.0) as usize, (b as usize).min(self.dims[k] - 1)))
         };
         let (rx, ry, rz) = (range(0)?, range(1)?, range(2)?);
+        let d = p1 - p0;
+        let len2 = d.norm_squared();
+        // A cell can hold a sample within `rad` of the segment only if its centre is within
+        // `rad` plus half its diagonal.
+        let reach = rad + 0.5 * 3f64.sqrt() * self.cell;
+        let reach2 = reach * reach;
+        let half = 0.5 * self.cell;
         for k in rz.0..=rz.1 {
+            let z = self.origin[2] + k as f64 * self.cell + half;
             for j in ry.0..=ry.1 {
+                let y = self.origin[1] + j as f64 * self.cell + half;
                 let row = (k * self.dims[1] + j) * self.dims[0];
-                let (a, b) = (
-                    self.start[row + rx.0] as usize,
-                    self.start[row + rx.1 + 1] as usize,
-                );
-                if let Some(p) = self.sorted[a..b].iter().find(test) {
-                    return Some(*p);
+                for i in rx.0..=rx.1 {
+                    let (a, b) = (
+                        self.start[row + i] as usize,
+                        self.start[row + i + 1] as usize,
+                    );
+                    if a == b {
+                        continue;
+                    }
+                    let q = Point3::new(self.origin[0] + i as f64 * self.cell + half, y, z);
+                    let t = if len2 > 0.0 {
+                        ((q - p0).dot(&d) / len2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    if (p0 + d * t - q).norm_squared() > reach2 {
+                        continue;
+                    }
+                    if let Some(p) = self.sorted[a..b].iter().find(|q| test(q)) {
+                        return Some(*p);
+                    }
                 }
             }
         }
         None
+    }
+
+    /// A sample inside the cylinder from `c + axis·a0` to `c + axis·a1` of radius `rad`
+    /// (grown by the sampling gap), if there is one; vertical axes are tried on the height
+    /// map first.
+    fn segment_hit(
+        &self,
+        c: &Point3,
+        axis: &Vector3,
+        (a0, a1): (f64, f64),
+        rad: f64,
+    ) -> Option<Point3> {
+        if axis.z > 1.0 - VERTICAL_COS_SLACK
+            && self.below(c, rad + self.gap_mm, c.z + a0 - self.gap_mm)
+        {
+            return None;
+        }
+        self.cylinder_hit(c, axis, a0, a1, rad)
+    }
+}
+
+/// Axes this close to +Z (1 − cos of the angle) are vertical for the height-map test.
+const VERTICAL_COS_SLACK: f64 = 1e-15;
+
+/// The model sampled for collision tests of the tool above its flutes: densely for the thin
+/// shank, more coarsely for the wide holder (each set grows its cylinder by its own gap).
+pub struct Clearance {
+    shank: Obstacles,
+    holder: Obstacles,
+}
+
+impl Clearance {
+    /// Samples `model` for the shank and holder of `opts`.
+    pub fn new(model: &Model, opts: &PlanOptions) -> Clearance {
+        let most = model.surface.bbox().diagonal() / OBSTACLE_SAMPLES;
+        let fine = (SHANK_SPACING * opts.shank_radius()).min(most);
+        let coarse = (HOLDER_SPACING * opts.holder_radius_mm).min(most).max(fine);
+        // Cells about the size of the cylinder tested in them.
+        let shank = Obstacles::new(model, fine, CELL_RADII * opts.shank_radius());
+        let holder = Obstacles::new(model, coarse, CELL_RADII * opts.holder_radius_mm);
+        Clearance { shank, holder }
+    }
+
+    /// Largest sampling gap of the two sets (mm).
+    pub fn gap_mm(&self) -> f64 {
+        self.shank.gap_mm.max(self.holder.gap_mm)
     }
 
     /// A sample inside the shank (above the flutes) or the holder of a tool with its ball
@@ -219,27 +298,31 @@ impl Obstacles {
             opts.shank_length_mm,
             opts.holder_length_mm,
         );
-        if axis.z > 1.0 - 1e-15 {
-            // Vertical: the height map rules most points out at once.
-            let shank = self.below(c, opts.shank_radius() + self.gap_mm, c.z + f - self.gap_mm);
-            let holder = self.below(
-                c,
-                opts.holder_radius_mm + self.gap_mm,
-                c.z + ls - self.gap_mm,
-            );
-            if shank && holder {
-                return None;
-            }
-        }
-        self.cylinder_hit(c, axis, f, ls, opts.shank_radius())
-            .or_else(|| self.cylinder_hit(c, axis, ls, ls + lh, opts.holder_radius_mm))
+        self.shank
+            .segment_hit(c, axis, (f, ls), opts.shank_radius())
+            .or_else(|| {
+                self.holder
+                    .segment_hit(c, axis, (ls, ls + lh), opts.holder_radius_mm)
+            })
     }
 
     /// True if the shank and holder at `c` along `axis` are clear of every sample.
     pub fn clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
         self.hit(c, axis, opts).is_none()
     }
+
+    /// A sample closer than `rad` to the segment from `p0` to `p1`, from the dense set.
+    pub fn capsule_hit(&self, p0: &Point3, p1: &Point3, rad: f64) -> Option<Point3> {
+        self.shank.capsule_hit(p0, p1, rad)
+    }
 }
+
+/// Obstacle grid cell size, in radii of the cylinder tested against it.
+const CELL_RADII: f64 = 2.0;
+/// Shank obstacle sample spacing, in shank radii.
+const SHANK_SPACING: f64 = 0.25;
+/// Holder obstacle sample spacing, in holder radii.
+const HOLDER_SPACING: f64 = 0.04;
 
 /// Ratio of the coarse height map's cell to the fine one's.
 const COARSE: f64 = 8.0;
@@ -310,25 +393,50 @@ fn tilted(theta: f64, phi: f64) -> Vector3 {
     )
 }
 
-/// The least tilt (radians) along azimuth `phi` at which the tool is clear: the first clear
-/// one in steps of [`TILT_STEP_DEG`] up to the largest allowed, refined by bisection.
-fn least_tilt(obs: &Obstacles, c: &Point3, opts: &PlanOptions, phi: f64) -> Option<f64> {
+/// The least tilt (radians) along azimuth `phi` at which the tool is clear, to within the
+/// bisection: coarse steps of [`TILT_STEP_DEG`] up to the largest allowed, refined by
+/// bisection. With a `hint` (the previous point's tilt: it changes little from point to
+/// point) the coarse steps start there, going down while clear or up while not, so that
+/// a clear tilt costs a few tests instead of a scan from zero.
+fn least_tilt(
+    obs: &Clearance,
+    c: &Point3,
+    opts: &PlanOptions,
+    phi: f64,
+    hint: Option<f64>,
+) -> Option<f64> {
     let max = opts.max_tilt_deg.to_radians();
     let step = TILT_STEP_DEG.to_radians();
-    let mut hi = step.min(max);
-    loop {
-        if obs.clear(c, &tilted(hi, phi), opts) {
-            break;
+    let clear = |t: f64| obs.clear(c, &tilted(t, phi), opts);
+    // `hi` clear, `lo` not (or zero, where the vertical was found not clear).
+    let (mut lo, mut hi) = match hint.map(|h| h.max(step).min(max)) {
+        Some(h) if clear(h) => {
+            let mut hi = h;
+            loop {
+                let lo = (hi - step).max(0.0);
+                if lo <= 0.0 || !clear(lo) {
+                    break (lo, hi);
+                }
+                hi = lo;
+            }
         }
-        if hi >= max {
-            return None;
+        start => {
+            let mut hi = start.map_or(step.min(max), |h| (h + step).min(max));
+            loop {
+                if clear(hi) {
+                    break;
+                }
+                if hi >= max {
+                    return None;
+                }
+                hi = (hi + step).min(max);
+            }
+            ((hi - step).max(0.0), hi)
         }
-        hi = (hi + step).min(max);
-    }
-    let mut lo = (hi - step).max(0.0);
+    };
     for _ in 0..TILT_BISECTIONS {
         let mid = 0.5 * (lo + hi);
-        if obs.clear(c, &tilted(mid, phi), opts) {
+        if clear(mid) {
             hi = mid;
         } else {
             lo = mid;
@@ -341,23 +449,24 @@ fn least_tilt(obs: &Obstacles, c: &Point3, opts: &PlanOptions, phi: f64) -> Opti
 /// from the sample the vertical tool hits, and a little either side of that, the least of
 /// them; failing those, around the circle.
 fn clear_axis(
-    obs: &Obstacles,
+    obs: &Clearance,
     c: &Point3,
     opts: &PlanOptions,
     prev: &Vector3,
     hit: &Point3,
 ) -> Option<Vector3> {
     let away = (c.y - hit.y).atan2(c.x - hit.x);
+    let hint = (prev.z < 1.0 - 1e-12).then(|| prev.z.clamp(-1.0, 1.0).acos());
     let best = [away, away + SIDE_AZIMUTH, away - SIDE_AZIMUTH]
         .iter()
-        .filter_map(|&phi| least_tilt(obs, c, opts, phi).map(|t| (t, phi)))
+        .filter_map(|&phi| least_tilt(obs, c, opts, phi, hint).map(|t| (t, phi)))
         .min_by(|a, b| a.0.total_cmp(&b.0));
     // Keep turning the way the previous point did unless another way needs clearly less
     // tilt: the axis then does not swing round between neighbouring points.
     let kept = (prev.z < 1.0 - 1e-12)
         .then(|| {
             let phi = prev.y.atan2(prev.x);
-            least_tilt(obs, c, opts, phi).map(|t| (t, phi))
+            least_tilt(obs, c, opts, phi, hint).map(|t| (t, phi))
         })
         .flatten();
     let chosen = match (kept, best) {
@@ -367,7 +476,7 @@ fn clear_axis(
     .or_else(|| {
         (0..AZIMUTHS).find_map(|k| {
             let phi = away + k as f64 * std::f64::consts::TAU / AZIMUTHS as f64;
-            least_tilt(obs, c, opts, phi).map(|t| (t, phi))
+            least_tilt(obs, c, opts, phi, None).map(|t| (t, phi))
         })
     })?;
     Some(tilted(chosen.0, chosen.1))
@@ -391,6 +500,8 @@ pub struct AxisStats {
     pub blocked: usize,
     /// The first of those, for the report.
     pub first_blocked: Option<Point3>,
+    /// How the retracts and approaches were routed around the model.
+    pub air: super::air::AirStats,
 }
 
 /// Sets the tool axis of every move of `path`. With `max_tilt_deg` 0 (three-axis) the axis
@@ -403,9 +514,7 @@ pub fn assign(
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<AxisStats> {
     let r = path.tool_radius_mm;
-    let spacing =
-        (0.25 * opts.shank_radius()).min(model.surface.bbox().diagonal() / OBSTACLE_SAMPLES);
-    let obs = Obstacles::new(model, spacing);
+    let obs = Clearance::new(model, opts);
     let n = path.moves.len();
     let on_surface = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
     let mut axes: Vec<Vector3> = vec![Vector3::z(); n];
@@ -494,6 +603,7 @@ pub fn assign(
     for (m, a) in path.moves.iter_mut().zip(&axes) {
         m.tool_axis = *a;
     }
+    stats.air = super::air::route(model, path, opts, &obs);
     if stats.blocked > 0 && opts.max_tilt_deg > 0.0 {
         let p = stats.first_blocked.unwrap_or_else(Point3::origin);
         return Err(Error::Degenerate {

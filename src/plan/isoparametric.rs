@@ -393,6 +393,19 @@ impl Planned {
                 self.axes.blocked, p.x, p.y, p.z
             ));
         }
+        let air = &self.axes.air;
+        if air.escaped > 0 {
+            r.notes.push(format!(
+                "{} retract(s) or approach(es) back away from the surface (along the tool axis or the surface normal) before rising, to keep the ball out of the model",
+                air.escaped
+            ));
+        }
+        if let Some(p) = air.first_blocked {
+            r.notes.push(format!(
+                "{} retract(s) or approach(es) pass through the model whichever way they go, the first from ball centre ({:.3}, {:.3}, {:.3}) mm: use a five-axis machine or allow more tilt",
+                air.blocked, p.x, p.y, p.z
+            ));
+        }
         r
     }
 }

@@ -4,6 +4,7 @@
 //! Must not: parse files or write G-code; planners take a [`Model`](crate::model::Model)
 //! and return a [`Toolpath`].
 
+pub mod air;
 pub mod axis;
 pub mod corners;
 pub mod isoparametric;
