@@ -495,8 +495,16 @@ fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
     )
     .unwrap();
     let report = planned.report(&opts);
+    // The axis keeps leaning the way it leaned: big swings between neighbouring cut points
+    // are rare (switching sides for the least tilt made hundreds).
+    let swings = p
+        .moves
+        .windows(2)
+        .filter(|w| w[0].kind == MoveKind::Feed && w[1].kind == MoveKind::Feed)
+        .filter(|w| w[0].tool_axis.dot(&w[1].tool_axis) < 30f64.to_radians().cos())
+        .count();
     println!(
-        "head five-axis r={r} h={h}: {} CL points, {} tilted, largest axis step {:.1}°; max scallop {:.6} mm (bound {:.2e}), p95 {:.6}, unreached {}, max gouge {:.6} mm (bound {:.2e}), gouged beyond chordal {}, {} samples",
+        "head five-axis r={r} h={h}: {} CL points, {} tilted, largest axis step {:.1}°, {swings} steps over 30° while cutting; max scallop {:.6} mm (bound {:.2e}), p95 {:.6}, unreached {}, max gouge {:.6} mm (bound {:.2e}), gouged beyond chordal {}, {} samples",
         report.cl_points,
         planned.axes.tilted,
         report.max_axis_step_deg,
@@ -508,6 +516,10 @@ fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
         v.gouge_error_bound_mm,
         v.gouge_count,
         v.samples
+    );
+    assert!(
+        swings * 1000 < report.cl_points,
+        "{swings} axis swings over 30°"
     );
     assert_eq!(v.unreached_samples, 0, "the whole head is cut");
     assert!(v.max_scallop_mm <= h + v.scallop_error_bound_mm);

@@ -7,10 +7,11 @@
 //! flutes and the holder above the shank can hit walls elsewhere. The model is sampled densely
 //! (tessellation vertices and triangle centres) into a spatial grid; a candidate axis is clear
 //! when no sample lies inside the cylinders grown by the sampling gap. +Z is tested against a
-//! height map first (cheap); where it is not clear, tilts are searched around the circle,
-//! smallest first (preferring the azimuth of the previous point's axis), then refined by
-//! bisection. The least clear tilt changes continuously as the tool nears a wall, so the
-//! axis turns gradually without smoothing, and it is +Z wherever +Z is clear.
+//! height map first (cheap); where it is not clear, the tool leans the way the previous
+//! point leaned (or the nearest way that is clear), else away from the obstacle, at the
+//! least clear tilt that way, refined by bisection. The least clear tilt changes
+//! continuously as the tool nears a wall, so the axis turns gradually without smoothing,
+//! and it is +Z wherever +Z is clear.
 
 use super::toolpath::{MoveKind, Toolpath};
 use super::PlanOptions;
@@ -445,9 +446,9 @@ fn least_tilt(
     Some(hi)
 }
 
-/// A clear axis close to +Z at `c`: the least tilt along the previous point's azimuth, away
-/// from the sample the vertical tool hits, and a little either side of that, the least of
-/// them; failing those, around the circle.
+/// A clear axis at `c`, continuing the previous point's lean: the least clear tilt along
+/// its azimuth or the nearest clear one; else away from the sample the vertical tool hits;
+/// failing those, around the circle.
 fn clear_axis(
     obs: &Clearance,
     c: &Point3,
@@ -457,33 +458,45 @@ fn clear_axis(
 ) -> Option<Vector3> {
     let away = (c.y - hit.y).atan2(c.x - hit.x);
     let hint = (prev.z < 1.0 - 1e-12).then(|| prev.z.clamp(-1.0, 1.0).acos());
-    let best = [away, away + SIDE_AZIMUTH, away - SIDE_AZIMUTH]
-        .iter()
-        .filter_map(|&phi| least_tilt(obs, c, opts, phi, hint).map(|t| (t, phi)))
-        .min_by(|a, b| a.0.total_cmp(&b.0));
-    // Keep turning the way the previous point did unless another way needs clearly less
-    // tilt: the axis then does not swing round between neighbouring points.
-    let kept = (prev.z < 1.0 - 1e-12)
-        .then(|| {
-            let phi = prev.y.atan2(prev.x);
-            least_tilt(obs, c, opts, phi, hint).map(|t| (t, phi))
+    // Keep turning the way the previous point did, at the least tilt clear that way, even
+    // where another way needs less: the axis then does not swing round between
+    // neighbouring points (on the head at h = 0.05 mm, switching to a way needing 5° less
+    // swung the axis by more than 30° between neighbours 433 times, mean tilt 20.7°;
+    // keeping the way, twice, mean tilt 33°). Where the previous azimuth has no clear tilt,
+    // the nearest that has (turning either way in steps of `NEAR_AZIMUTH_STEP`).
+    let kept = hint.and_then(|_| {
+        let phi0 = prev.y.atan2(prev.x);
+        (0..=NEAR_AZIMUTH_STEPS).find_map(|k| {
+            let turn = k as f64 * NEAR_AZIMUTH_STEP.to_radians();
+            let sides: &[f64] = if k == 0 { &[0.0] } else { &[turn, -turn] };
+            sides
+                .iter()
+                .filter_map(|&d| least_tilt(obs, c, opts, phi0 + d, hint).map(|t| (t, phi0 + d)))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
         })
-        .flatten();
-    let chosen = match (kept, best) {
-        (Some(k), Some(b)) if k.0 <= b.0 + KEEP_AZIMUTH_SLACK.to_radians() => Some(k),
-        (k, b) => b.or(k),
-    }
-    .or_else(|| {
-        (0..AZIMUTHS).find_map(|k| {
-            let phi = away + k as f64 * std::f64::consts::TAU / AZIMUTHS as f64;
-            least_tilt(obs, c, opts, phi, None).map(|t| (t, phi))
+    });
+    // Otherwise (or leaving +Z) the least tilt away from the sample the vertical tool hits
+    // and a little either side of that; failing those, around the circle.
+    let chosen = kept
+        .or_else(|| {
+            [away, away + SIDE_AZIMUTH, away - SIDE_AZIMUTH]
+                .iter()
+                .filter_map(|&phi| least_tilt(obs, c, opts, phi, hint).map(|t| (t, phi)))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
         })
-    })?;
+        .or_else(|| {
+            (0..AZIMUTHS).find_map(|k| {
+                let phi = away + k as f64 * std::f64::consts::TAU / AZIMUTHS as f64;
+                least_tilt(obs, c, opts, phi, None).map(|t| (t, phi))
+            })
+        })?;
     Some(tilted(chosen.0, chosen.1))
 }
 
-/// Extra tilt accepted to keep the previous point's azimuth (degrees).
-const KEEP_AZIMUTH_SLACK: f64 = 5.0;
+/// Azimuth steps (degrees) and how many either way are tried near the previous point's
+/// azimuth when it is blocked.
+const NEAR_AZIMUTH_STEP: f64 = 15.0;
+const NEAR_AZIMUTH_STEPS: usize = 6;
 
 /// Rotates `v` about unit `k` by `angle` (Rodrigues).
 fn rotate(v: &Vector3, k: &Vector3, angle: f64) -> Vector3 {
