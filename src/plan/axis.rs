@@ -271,7 +271,9 @@ const VERTICAL_COS_SLACK: f64 = 1e-15;
 /// shank, more coarsely for the wide holder (each set grows its cylinder by its own gap).
 pub struct Clearance {
     shank: Obstacles,
-    holder: Obstacles,
+    /// `None`: the holder is tested against the shank's samples (when a coarser set would
+    /// hardly be coarser).
+    holder: Option<Obstacles>,
 }
 
 impl Clearance {
@@ -282,13 +284,18 @@ impl Clearance {
         let coarse = (HOLDER_SPACING * opts.holder_radius_mm).min(most).max(fine);
         // Cells about the size of the cylinder tested in them.
         let shank = Obstacles::new(model, fine, CELL_RADII * opts.shank_radius());
-        let holder = Obstacles::new(model, coarse, CELL_RADII * opts.holder_radius_mm);
+        let holder = (coarse > 2.0 * fine)
+            .then(|| Obstacles::new(model, coarse, CELL_RADII * opts.holder_radius_mm));
         Clearance { shank, holder }
+    }
+
+    fn holder(&self) -> &Obstacles {
+        self.holder.as_ref().unwrap_or(&self.shank)
     }
 
     /// Largest sampling gap of the two sets (mm).
     pub fn gap_mm(&self) -> f64 {
-        self.shank.gap_mm.max(self.holder.gap_mm)
+        self.shank.gap_mm.max(self.holder().gap_mm)
     }
 
     /// A sample inside the shank (above the flutes) or the holder of a tool with its ball
@@ -302,7 +309,7 @@ impl Clearance {
         self.shank
             .segment_hit(c, axis, (f, ls), opts.shank_radius())
             .or_else(|| {
-                self.holder
+                self.holder()
                     .segment_hit(c, axis, (ls, ls + lh), opts.holder_radius_mm)
             })
     }
