@@ -442,6 +442,31 @@ test('Cancel stops a long plan within 0.5 s; the page answers clicks while plann
   return `cancel ${cancel.ms.toFixed(1)} ms (at ${(100 * progress).toFixed(1)} % done); click during planning answered in ${clickMs} ms, event-loop lag ${lag.toFixed(1)} ms; next plan done ${after} ms later`;
 });
 
+test('the closed head, five-axis from the URL: cut all round, no gouge, same as the CLI', async (page, url) => {
+  const h = 0.05;
+  // Enough samples for a finite error bound on the faces round the extraordinary points.
+  await page.goto(`${url}?model=head&machine=table-table-ac&max-tilt=90&scallop=${h}&samples=1000000&plan=1`);
+  await waitPlans(page, 1, 180000);
+  await waitVerified(page, 120000);
+  const notes = (await page.$$eval('#notes li', (li) => li.map((n) => n.textContent.trim()))).join(' / ');
+  check(!/would hit/.test(notes), `tilting up to 90° clears the holder everywhere: ${notes}`);
+  const unreached = await stat(page, 'unreached_fraction');
+  check(unreached.value === 0, `the whole head is reached (${unreached.text})`);
+  const gouges = await stat(page, 'gouge_count');
+  check(gouges.value === 0, `no gouge (${gouges.text})`);
+  const sim = await stat(page, 'max_scallop_mm');
+  const bound = await stat(page, 'error_bound_mm');
+  check(Number.isFinite(bound.value) && sim.value <= h + bound.value, `simulated scallop ${sim.text} within ${h} mm + bound ${bound.text}`);
+  const cli = cliPlan('head', { toolRadius: 0.5, scallop: h, machine: 'table-table-ac', extra: ['--max-tilt', '90'] });
+  const cl = await stat(page, 'cl_points');
+  const step = await stat(page, 'max_axis_step_deg');
+  check(cl.value === cli.report.cl_points && near(step.value, cli.report.max_axis_step_deg, 1e-9),
+    `page ${cl.value} CL points, largest axis step ${step.value}°; CLI ${cli.report.cl_points}, ${cli.report.max_axis_step_deg}°`);
+  const plan = await stat(page, 'plan_ms');
+  await page.screenshot({ path: join(shots, 'head-five-axis.png') });
+  return `${cl.value} CL points planned in ${plan.text}, simulated scallop ${sim.text} (bound ${bound.text}), unreached ${unreached.text}, gouges ${gouges.text}; note: ${notes.slice(0, 90)}…`;
+});
+
 test('the URL reproduces a plan', async (page, url, context) => {
   await page.goto(url);
   await waitState(page, 'model-loaded');
