@@ -32,8 +32,9 @@ const SIDE_AZIMUTH: f64 = std::f64::consts::FRAC_PI_6;
 /// axes.
 pub struct Obstacles {
     cell: f64,
-    /// Samples sorted by grid cell: those of cell `k` are `sorted[start[k]..start[k + 1]]`.
-    sorted: Vec<Point3>,
+    /// Samples sorted by grid cell: those of cell `k` are `sorted[start[k]..start[k + 1]]`
+    /// (single precision: half the memory; the rounding is added to the gap).
+    sorted: Vec<[f32; 3]>,
     start: Vec<u32>,
     /// Grid origin and size in cells.
     origin: [f64; 3],
@@ -90,7 +91,11 @@ impl Obstacles {
         }
         // Every point of a triangle is within 0.58 of the lattice spacing of a lattice point,
         // and the surface within the chordal tolerance of the triangle.
-        let gap_mm = 0.58 * worst + chordal;
+        let reach = points
+            .iter()
+            .map(|q| q.coords.amax())
+            .fold(0.0f64, f64::max);
+        let gap_mm = 0.58 * worst + chordal + F32_ROUNDING * reach;
         let cell = cell_mm.min(size / GRID_CELLS).max(gap_mm);
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for q in &points {
@@ -112,14 +117,14 @@ impl Obstacles {
             start[k] += start[k - 1];
         }
         let mut fill = start.clone();
-        let mut sorted = vec![Point3::origin(); points.len()];
-        for q in &points {
-            let k = index(q);
-            sorted[fill[k] as usize] = *q;
-            fill[k] += 1;
-        }
         let heights = HeightMap::new(&points, cell);
         let coarse = HeightMap::new(&points, cell * COARSE);
+        let mut sorted = vec![[0.0f32; 3]; points.len()];
+        for q in &points {
+            let k = index(q);
+            sorted[fill[k] as usize] = [q.x as f32, q.y as f32, q.z as f32];
+            fill[k] += 1;
+        }
         Obstacles {
             cell,
             sorted,
@@ -236,8 +241,12 @@ impl Obstacles {
                     if (p0 + d * t - q).norm_squared() > reach2 {
                         continue;
                     }
-                    if let Some(p) = self.sorted[a..b].iter().find(|q| test(q)) {
-                        return Some(*p);
+                    if let Some(p) = self.sorted[a..b]
+                        .iter()
+                        .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
+                        .find(|q| test(q))
+                    {
+                        return Some(p);
                     }
                 }
             }
@@ -331,6 +340,9 @@ const CELL_RADII: f64 = 2.0;
 const SHANK_SPACING: f64 = 0.25;
 /// Holder obstacle sample spacing, in holder radii.
 const HOLDER_SPACING: f64 = 0.04;
+
+/// Relative rounding of a coordinate stored in single precision (2⁻²⁴).
+const F32_ROUNDING: f64 = 6.0e-8;
 
 /// Ratio of the coarse height map's cell to the fine one's.
 const COARSE: f64 = 8.0;
