@@ -58,73 +58,81 @@ impl Obstacles {
         let size = model.surface.bbox().diagonal().max(1e-6);
         let chordal = (0.25 * spacing).max(size * 2e-4);
         let t = model.tessellate(chordal);
-        let p = |i: u32| {
-            let k = 3 * i as usize;
-            Point3::new(
-                t.positions[k] as f64,
-                t.positions[k + 1] as f64,
-                t.positions[k + 2] as f64,
-            )
-        };
-        let mut points: Vec<Point3> = (0..t.positions.len() as u32 / 3).map(p).collect();
+        let vertices: Vec<Point3> = t
+            .positions
+            .chunks(3)
+            .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
+            .collect();
+        // Lattice divisions per triangle side, and the lattice spacing reached.
         let mut worst: f64 = 0.0;
-        for tri in t.indices.chunks(3) {
-            let (a, b, c) = (p(tri[0]), p(tri[1]), p(tri[2]));
-            let longest = (a - b).norm().max((b - c).norm()).max((c - a).norm());
-            // A barycentric lattice of n divisions per side: its spacing is longest / n.
-            let n = ((longest / spacing).ceil() as usize).max(1);
-            for i in 0..=n {
-                for j in 0..=n - i {
-                    let k = n - i - j;
-                    if i == n || j == n || k == n {
-                        continue; // the vertices are in already
+        let divisions: Vec<usize> = t
+            .indices
+            .chunks(3)
+            .map(|tri| {
+                let [a, b, c] = [0, 1, 2].map(|k| vertices[tri[k] as usize]);
+                let longest = (a - b).norm().max((b - c).norm()).max((c - a).norm());
+                let n = ((longest / spacing).ceil() as usize).max(1);
+                worst = worst.max(longest / n as f64);
+                n
+            })
+            .collect();
+        // Every sample: the vertices, and inside each triangle a barycentric lattice of `n`
+        // divisions per side (spacing longest / n). Generated again for each pass instead
+        // of stored: the samples of a large model at a thin shank's spacing run to millions.
+        let each_sample = |f: &mut dyn FnMut(&Point3)| {
+            vertices.iter().for_each(&mut *f);
+            for (tri, &n) in t.indices.chunks(3).zip(&divisions) {
+                let [a, b, c] = [0, 1, 2].map(|k| vertices[tri[k] as usize]);
+                for i in 0..=n {
+                    for j in 0..=n - i {
+                        let k = n - i - j;
+                        if i == n || j == n || k == n {
+                            continue; // the vertices are in already
+                        }
+                        let [x, y, z] = [i, j, k].map(|m| m as f64 / n as f64);
+                        f(&Point3::from(a.coords * x + b.coords * y + c.coords * z));
                     }
-                    let (x, y, z) = (
-                        i as f64 / n as f64,
-                        j as f64 / n as f64,
-                        k as f64 / n as f64,
-                    );
-                    points.push(Point3::from(a.coords * x + b.coords * y + c.coords * z));
                 }
             }
-            worst = worst.max(longest / n as f64);
-        }
-        // Every point of a triangle is within 0.58 of the lattice spacing of a lattice point,
-        // and the surface within the chordal tolerance of the triangle.
-        let reach = points
-            .iter()
-            .map(|q| q.coords.amax())
-            .fold(0.0f64, f64::max);
-        let gap_mm = 0.58 * worst + chordal + F32_ROUNDING * reach;
-        let cell = cell_mm.min(size / GRID_CELLS).max(gap_mm);
+        };
+        // Lattice points lie in their triangles: the vertices bound them all.
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for q in &points {
+        for q in &vertices {
             for k in 0..3 {
                 lo[k] = lo[k].min(q[k]);
                 hi[k] = hi[k].max(q[k]);
             }
         }
+        let reach = (0..3)
+            .map(|k| lo[k].abs().max(hi[k].abs()))
+            .fold(0.0, f64::max);
+        // Every point of a triangle is within 0.58 of the lattice spacing of a lattice point,
+        // and the surface within the chordal tolerance of the triangle.
+        let gap_mm = 0.58 * worst + chordal + F32_ROUNDING * reach;
+        let cell = cell_mm.min(size / GRID_CELLS).max(gap_mm);
         let dims = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).max(1));
         let index = |q: &Point3| {
             let c = [0, 1, 2].map(|k| (((q[k] - lo[k]) / cell) as usize).min(dims[k] - 1));
             (c[2] * dims[1] + c[1]) * dims[0] + c[0]
         };
+        let mut heights = HeightMap::new(lo, hi, cell);
+        let mut coarse = HeightMap::new(lo, hi, cell * COARSE);
         let mut start = vec![0u32; dims[0] * dims[1] * dims[2] + 1];
-        for q in &points {
+        each_sample(&mut |q| {
             start[index(q) + 1] += 1;
-        }
+            heights.add(q);
+            coarse.add(q);
+        });
         for k in 1..start.len() {
             start[k] += start[k - 1];
         }
         let mut fill = start.clone();
-        let heights = HeightMap::new(&points, cell);
-        let coarse = HeightMap::new(&points, cell * COARSE);
-        let mut sorted = vec![[0.0f32; 3]; points.len()];
-        for q in &points {
+        let mut sorted = vec![[0.0f32; 3]; start[start.len() - 1] as usize];
+        each_sample(&mut |q| {
             let k = index(q);
             sorted[fill[k] as usize] = [q.x as f32, q.y as f32, q.z as f32];
             fill[k] += 1;
-        }
+        });
         Obstacles {
             cell,
             sorted,
@@ -357,27 +365,25 @@ struct HeightMap {
 }
 
 impl HeightMap {
-    fn new(points: &[Point3], cell: f64) -> HeightMap {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in points {
-            lo = [lo[0].min(p.x), lo[1].min(p.y)];
-            hi = [hi[0].max(p.x), hi[1].max(p.y)];
-        }
+    /// An empty map over the x–y extent of the box from `lo` to `hi`.
+    fn new(lo: [f64; 3], hi: [f64; 3], cell: f64) -> HeightMap {
         let nx = (((hi[0] - lo[0]) / cell).floor() as usize + 1).max(1);
         let ny = (((hi[1] - lo[1]) / cell).floor() as usize + 1).max(1);
-        let mut max_z = vec![f64::NEG_INFINITY; nx * ny];
-        for p in points {
-            let i = (((p.x - lo[0]) / cell) as usize).min(nx - 1);
-            let j = (((p.y - lo[1]) / cell) as usize).min(ny - 1);
-            max_z[j * nx + i] = max_z[j * nx + i].max(p.z);
-        }
         HeightMap {
             cell,
-            origin: lo,
+            origin: [lo[0], lo[1]],
             nx,
             ny,
-            max_z,
+            max_z: vec![f64::NEG_INFINITY; nx * ny],
         }
+    }
+
+    /// Raises the column of `p` to its height.
+    fn add(&mut self, p: &Point3) {
+        let i = (((p.x - self.origin[0]) / self.cell) as usize).min(self.nx - 1);
+        let j = (((p.y - self.origin[1]) / self.cell) as usize).min(self.ny - 1);
+        let h = &mut self.max_z[j * self.nx + i];
+        *h = h.max(p.z);
     }
 
     fn below(&self, c: &Point3, radius: f64, z: f64) -> bool {
