@@ -492,3 +492,75 @@ fn lead_and_tilt_incline_the_axis_from_the_normal() {
         assert!(n > 100);
     }
 }
+
+/// Least distance (mm) from the segment `a`–`b` to any of `samples`.
+fn segment_clearance(samples: &[Point3], a: &Point3, b: &Point3) -> f64 {
+    let d = b - a;
+    let len2 = d.norm_squared();
+    samples
+        .iter()
+        .map(|q| {
+            let t = if len2 > 0.0 {
+                ((q - a).dot(&d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (a + d * t - q).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn air_moves_keep_the_ball_out_of_the_closed_head() {
+    // Starting on patch 1 the first cut lies under the head's overhang: coming straight down
+    // onto it would pass through the head. The approach must go round (the final retract
+    // after a last cut under the overhang is `verify.rs`'s head test), and every air move's
+    // ball must stay clear of the surface (checked against dense surface samples, without
+    // the planner's index).
+    let m = samples::load_sample("head").unwrap();
+    let mut opts = PlanOptions::default()
+        .with_tool_radius(1.0)
+        .with_scallop(0.3);
+    opts.max_tilt_deg = 90.0;
+    opts.start_patch = Some(1);
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+    let path = &planned.toolpath;
+    let air = planned.axes.air;
+    assert_eq!(air.blocked, 0);
+    let kinds: Vec<MoveKind> = path.moves.iter().take(3).map(|m| m.kind).collect();
+    assert_eq!(
+        kinds,
+        [MoveKind::Rapid, MoveKind::Rapid, MoveKind::Plunge],
+        "the approach comes down beside the head and plunges from there"
+    );
+    assert!(air.escaped >= 1);
+    let t = m.tessellate(0.01);
+    let samples: Vec<Point3> = t
+        .positions
+        .chunks(3)
+        .map(|p| Point3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+        .collect();
+    let r = opts.tool_radius_mm;
+    let mut least = f64::INFINITY;
+    let mut checked = 0;
+    for (i, w) in path.moves.windows(2).enumerate() {
+        let air_move = matches!(w[1].kind, MoveKind::Retract | MoveKind::Rapid)
+            || (w[1].kind == MoveKind::Plunge && w[0].kind == MoveKind::Rapid);
+        if !air_move {
+            continue;
+        }
+        let c = segment_clearance(&samples, &w[0].cl_point, &w[1].cl_point);
+        least = least.min(c);
+        checked += 1;
+        // The ball touches the surface where it lands (within the chordal tolerance).
+        assert!(
+            c > r - opts.chordal_mm - 1e-3,
+            "move {}: the ball passes {c} mm from the surface (radius {r} mm)",
+            i + 1
+        );
+    }
+    println!(
+        "head from patch 1: {} air moves routed round the head, {checked} checked, least ball-centre clearance {least:.4} mm (r {r} mm)",
+        air.escaped
+    );
+}

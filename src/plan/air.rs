@@ -72,6 +72,13 @@ fn escape_directions(cut: &Move) -> [Vector3; 3] {
     [cut.tool_axis, normal, Vector3::new(normal.x, normal.y, 0.0)]
 }
 
+/// Whether an air move leaves a cut or comes down to one.
+#[derive(Clone, Copy)]
+enum Leg {
+    Leaving,
+    Arriving,
+}
+
 enum Way {
     Straight,
     Escape(Point3),
@@ -135,61 +142,47 @@ pub fn route(model: &Model, path: &mut Toolpath, opts: &PlanOptions, obs: &Clear
                 params.push(q);
             }
         };
-        match m.kind {
-            // The first retract after a cut.
+        // The cut this air move leaves (the first retract after a cut) or comes down to (the
+        // rapid above the next cut, before its plunge).
+        let cut = match m.kind {
             MoveKind::Retract if i > 0 && on_surface(path.moves[i - 1].kind) => {
-                let cut = path.moves[i - 1];
-                match way_up(
-                    &sweep,
-                    &grown,
-                    &cut.cl_point,
-                    &escape_directions(&cut),
-                    m.cl_point.z,
-                ) {
-                    Way::Straight => push(m),
-                    Way::Escape(e) => {
-                        stats.escaped += 1;
-                        push(Move { cl_point: e, ..m });
-                        push(Move {
-                            cl_point: Point3::new(e.x, e.y, m.cl_point.z),
-                            ..m
-                        });
-                    }
-                    Way::Blocked => {
-                        blocked(&mut stats, cut.cl_point);
-                        push(m);
-                    }
-                }
+                Some((path.moves[i - 1], Leg::Leaving))
             }
-            // The rapid above the next cut, before its plunge.
             MoveKind::Rapid
                 if path
                     .moves
                     .get(i + 1)
                     .is_some_and(|x| x.kind == MoveKind::Plunge) =>
             {
-                let cut = path.moves[i + 1];
-                match way_up(
-                    &sweep,
-                    &grown,
-                    &cut.cl_point,
-                    &escape_directions(&cut),
-                    m.cl_point.z,
-                ) {
-                    Way::Straight => push(m),
-                    Way::Escape(e) => {
-                        stats.escaped += 1;
-                        push(Move {
-                            cl_point: Point3::new(e.x, e.y, m.cl_point.z),
-                            ..m
-                        });
-                        push(Move { cl_point: e, ..m });
-                    }
-                    Way::Blocked => {
-                        blocked(&mut stats, cut.cl_point);
-                        push(m);
-                    }
+                Some((path.moves[i + 1], Leg::Arriving))
+            }
+            _ => None,
+        };
+        let safe_z = m.cl_point.z;
+        match cut.map(|(cut, leg)| {
+            let way = way_up(
+                &sweep,
+                &grown,
+                &cut.cl_point,
+                &escape_directions(&cut),
+                safe_z,
+            );
+            (way, cut, leg)
+        }) {
+            Some((Way::Escape(e), _, leg)) => {
+                stats.escaped += 1;
+                let above = Point3::new(e.x, e.y, safe_z);
+                let points = match leg {
+                    Leg::Leaving => [e, above],
+                    Leg::Arriving => [above, e],
+                };
+                for p in points {
+                    push(Move { cl_point: p, ..m });
                 }
+            }
+            Some((Way::Blocked, cut, _)) => {
+                blocked(&mut stats, cut.cl_point);
+                push(m);
             }
             _ => push(m),
         }
