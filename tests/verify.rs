@@ -504,9 +504,11 @@ fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
         .filter(|w| w[0].tool_axis.dot(&w[1].tool_axis) < 30f64.to_radians().cos())
         .count();
     println!(
-        "head five-axis r={r} h={h}: {} CL points, {} tilted, largest axis step {:.1}°, {swings} steps over 30° while cutting; max scallop {:.6} mm (bound {:.2e}), p95 {:.6}, unreached {}, max gouge {:.6} mm (bound {:.2e}), gouged beyond chordal {}, {} samples",
+        "head five-axis r={r} h={h}: {} CL points, {} tilted, {} turns split to keep the shank and holder clear while turning, {} still blocked, largest axis step {:.1}°, {swings} steps over 30° while cutting; max scallop {:.6} mm (bound {:.2e}), p95 {:.6}, unreached {}, max gouge {:.6} mm (bound {:.2e}), gouged beyond chordal {}, {} samples",
         report.cl_points,
         planned.axes.tilted,
+        planned.axes.bridged,
+        planned.axes.sweep_hits,
         report.max_axis_step_deg,
         v.max_scallop_mm,
         v.scallop_error_bound_mm,
@@ -520,6 +522,11 @@ fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
     assert!(
         swings * 1000 < report.cl_points,
         "{swings} axis swings over 30°"
+    );
+    assert!(
+        planned.axes.sweep_hits * 10_000 < report.cl_points,
+        "{} turns put the shank or holder into the head",
+        planned.axes.sweep_hits
     );
     assert_eq!(v.unreached_samples, 0, "the whole head is cut");
     assert!(v.max_scallop_mm <= h + v.scallop_error_bound_mm);

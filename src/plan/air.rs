@@ -127,34 +127,20 @@ pub fn route(model: &Model, path: &mut Toolpath, opts: &PlanOptions, obs: &Clear
         stats.blocked += 1;
         stats.first_blocked.get_or_insert(p);
     };
-    let n = path.moves.len();
-    let mut moves: Vec<Move> = Vec::with_capacity(n);
-    let mut params: Vec<[f64; 2]> = Vec::with_capacity(path.params.len());
-    // First and last new index of each old move.
-    let mut new_index = vec![(0usize, 0usize); n];
-    for i in 0..n {
-        let first = moves.len();
-        let m = path.moves[i];
-        let param = path.params.get(i).copied();
-        let mut push = |mv: Move| {
-            moves.push(mv);
-            if let Some(q) = param {
-                params.push(q);
-            }
-        };
+    let old = path.moves.clone();
+    let old_params = path.params.clone();
+    path.rebuild(|i, add| {
+        let m = old[i];
+        let param = old_params.get(i).copied().unwrap_or_default();
+        let mut push = |mv: Move| add(mv, param);
         // The cut this air move leaves (the first retract after a cut) or comes down to (the
         // rapid above the next cut, before its plunge).
         let cut = match m.kind {
-            MoveKind::Retract if i > 0 && on_surface(path.moves[i - 1].kind) => {
-                Some((path.moves[i - 1], Leg::Leaving))
+            MoveKind::Retract if i > 0 && on_surface(old[i - 1].kind) => {
+                Some((old[i - 1], Leg::Leaving))
             }
-            MoveKind::Rapid
-                if path
-                    .moves
-                    .get(i + 1)
-                    .is_some_and(|x| x.kind == MoveKind::Plunge) =>
-            {
-                Some((path.moves[i + 1], Leg::Arriving))
+            MoveKind::Rapid if old.get(i + 1).is_some_and(|x| x.kind == MoveKind::Plunge) => {
+                Some((old[i + 1], Leg::Arriving))
             }
             _ => None,
         };
@@ -186,16 +172,7 @@ pub fn route(model: &Model, path: &mut Toolpath, opts: &PlanOptions, obs: &Clear
             }
             _ => push(m),
         }
-        new_index[i] = (first, moves.len() - 1);
-    }
-    if moves.len() != n {
-        for run in &mut path.runs {
-            run.first_move = new_index[run.first_move].0;
-            run.last_move = new_index[run.last_move].1;
-        }
-        path.moves = moves;
-        path.params = params;
-    }
+    });
     stats
 }
 

@@ -13,7 +13,7 @@
 //! continuously as the tool nears a wall, so the axis turns gradually without smoothing,
 //! and it is +Z wherever +Z is clear.
 
-use super::toolpath::{MoveKind, Toolpath};
+use super::toolpath::{Move, MoveKind, Toolpath};
 use super::PlanOptions;
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
@@ -538,9 +538,129 @@ pub struct AxisStats {
     pub blocked: usize,
     /// The first of those, for the report.
     pub first_blocked: Option<Point3>,
+    /// Moves between two cut points whose axis turn was split into smaller clear turns.
+    pub bridged: usize,
+    /// Moves between two cut points during which the turning tool's shank or holder
+    /// still passes through the model (poses checked every [`SWEEP_STEP_DEG`] of turn).
+    pub sweep_hits: usize,
+    /// The end of the first of those (ball centre, mm).
+    pub first_sweep_hit: Option<Point3>,
     /// How the retracts and approaches were routed around the model.
     pub air: super::air::AirStats,
 }
+
+/// Turn of the tool axis between the poses checked while it turns from one cut point to
+/// the next (degrees).
+const SWEEP_STEP_DEG: f64 = 2.0;
+
+/// True if a pose between cut points `a` and `b` (ball centre and axis interpolated
+/// linearly, every [`SWEEP_STEP_DEG`] of turn) puts the shank or holder into the model.
+fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool {
+    let step = SWEEP_STEP_DEG.to_radians();
+    let turn = a.tool_axis.angle(&b.tool_axis);
+    if turn <= step {
+        return false;
+    }
+    let poses = (turn / step).ceil() as usize;
+    (1..poses).any(|k| {
+        let s = k as f64 / poses as f64;
+        let c = a.cl_point + (b.cl_point - a.cl_point) * s;
+        match (a.tool_axis * (1.0 - s) + b.tool_axis * s).try_normalize(AXIS_MIN_NORM) {
+            Some(axis) => !obs.clear(&c, &axis, opts),
+            // Opposite axes: no defined turn, count it.
+            None => true,
+        }
+    })
+}
+
+/// Halvings of a blocked turn before it is given up.
+const BRIDGE_DEPTH: usize = 6;
+
+/// Appends to `out` cut points between `a` and `b` (at fractions of the way from `s0` to
+/// `s1`) that split a blocked turn into clear ones: the midpoint of the chord with +Z if
+/// that is clear, else the interpolated axis if clear, else the least tilt leaning from
+/// `a`'s; then each half likewise. False if some turn stays blocked.
+#[allow(clippy::too_many_arguments)]
+fn bridge(
+    a: &Move,
+    b: &Move,
+    (s0, s1): (f64, f64),
+    obs: &Clearance,
+    opts: &PlanOptions,
+    depth: usize,
+    out: &mut Vec<(Move, f64)>,
+) -> bool {
+    if !turn_blocked(a, b, obs, opts) {
+        return true;
+    }
+    if depth == 0 {
+        return false;
+    }
+    let cl = Point3::from((a.cl_point.coords + b.cl_point.coords) * 0.5);
+    let cc = Point3::from((a.cc_point.coords + b.cc_point.coords) * 0.5);
+    let axis = match obs.hit(&cl, &Vector3::z(), opts) {
+        None => Some(Vector3::z()),
+        Some(h) => (a.tool_axis + b.tool_axis)
+            .try_normalize(AXIS_MIN_NORM)
+            .filter(|x| obs.clear(&cl, x, opts))
+            .or_else(|| clear_axis(obs, &cl, opts, &a.tool_axis, &h)),
+    };
+    let Some(axis) = axis else {
+        return false;
+    };
+    let mid = Move {
+        cl_point: cl,
+        cc_point: cc,
+        tool_axis: axis,
+        ..*b
+    };
+    let sm = 0.5 * (s0 + s1);
+    let first = bridge(a, &mid, (s0, sm), obs, opts, depth - 1, out);
+    out.push((mid, sm));
+    let second = bridge(&mid, b, (sm, s1), obs, opts, depth - 1, out);
+    first && second
+}
+
+/// Splits every turn of the axis between two cut points whose in-between poses would put
+/// the shank or holder into the model (see [`bridge`]); counts the splits and the turns
+/// that stay blocked.
+fn bridge_turns(path: &mut Toolpath, obs: &Clearance, opts: &PlanOptions, stats: &mut AxisStats) {
+    let on_surface = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
+    let old = path.moves.clone();
+    let old_params = path.params.clone();
+    path.rebuild(|i, add| {
+        let b = old[i];
+        let q = old_params.get(i).copied().unwrap_or_default();
+        if i > 0 && on_surface(old[i - 1].kind) && matches!(b.kind, MoveKind::Feed | MoveKind::Link)
+        {
+            let mut inserted = Vec::new();
+            let clear = bridge(
+                &old[i - 1],
+                &b,
+                (0.0, 1.0),
+                obs,
+                opts,
+                BRIDGE_DEPTH,
+                &mut inserted,
+            );
+            if !inserted.is_empty() {
+                stats.bridged += 1;
+            }
+            let qa = old_params.get(i - 1).copied().unwrap_or_default();
+            for (m, s) in inserted {
+                add(m, [qa[0] + (q[0] - qa[0]) * s, qa[1] + (q[1] - qa[1]) * s]);
+            }
+            if !clear {
+                stats.sweep_hits += 1;
+                stats.first_sweep_hit.get_or_insert(b.cl_point);
+            }
+        }
+        add(b, q);
+    });
+}
+
+/// Shortest interpolated axis (before normalising) taken as a direction.
+const AXIS_MIN_NORM: f64 = 1e-9;
 
 /// Sets the tool axis of every move of `path`. With `max_tilt_deg` 0 (three-axis) the axis
 /// stays +Z and collisions are counted; otherwise a point where no allowed axis is clear is
@@ -641,6 +761,7 @@ pub fn assign(
     for (m, a) in path.moves.iter_mut().zip(&axes) {
         m.tool_axis = *a;
     }
+    bridge_turns(path, &obs, opts, &mut stats);
     stats.air = super::air::route(model, path, opts, &obs);
     if stats.blocked > 0 && opts.max_tilt_deg > 0.0 {
         let p = stats.first_blocked.unwrap_or_else(Point3::origin);

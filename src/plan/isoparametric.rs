@@ -393,6 +393,18 @@ impl Planned {
                 self.axes.blocked, p.x, p.y, p.z
             ));
         }
+        if self.axes.bridged > 0 {
+            r.notes.push(format!(
+                "at {} moves the tool axis turns in smaller steps through added cut points, so that the shank and holder stay clear while it turns",
+                self.axes.bridged
+            ));
+        }
+        if let Some(p) = self.axes.first_sweep_hit {
+            r.notes.push(format!(
+                "at {} moves the shank or holder passes through the model while the tool axis turns between two cut points, the first ending at ball centre ({:.3}, {:.3}, {:.3}) mm: allow more tilt, use a longer shank or a smaller holder",
+                self.axes.sweep_hits, p.x, p.y, p.z
+            ));
+        }
         let air = &self.axes.air;
         if air.escaped > 0 {
             r.notes.push(format!(

@@ -99,6 +99,41 @@ pub struct PlanReport {
 pub const RAPID_MM_MIN: f64 = 5000.0;
 
 impl Toolpath {
+    /// Rebuilds the moves: `f(i, add)` adds, through `add(move, params)`, the moves that
+    /// replace old move `i` (at least one each, the last standing for it). Keeps `runs` and
+    /// `params` in step; `params` of added moves are used only where the path has them.
+    pub fn rebuild(&mut self, mut f: impl FnMut(usize, &mut dyn FnMut(Move, [f64; 2]))) {
+        let n = self.moves.len();
+        let has_params = self.params.len() == n;
+        let mut moves: Vec<Move> = Vec::with_capacity(n);
+        let mut params: Vec<[f64; 2]> = Vec::with_capacity(self.params.len());
+        // First and last new index of each old move.
+        let mut new_index = vec![(0usize, 0usize); n];
+        for (i, slot) in new_index.iter_mut().enumerate() {
+            let first = moves.len();
+            f(i, &mut |m, q| {
+                moves.push(m);
+                if has_params {
+                    params.push(q);
+                }
+            });
+            debug_assert!(moves.len() > first, "move {i} was dropped");
+            *slot = (first, moves.len().max(first + 1) - 1);
+        }
+        if moves.len() == n {
+            self.moves = moves;
+            return;
+        }
+        for run in &mut self.runs {
+            run.first_move = new_index[run.first_move].0;
+            run.last_move = new_index[run.last_move].1;
+        }
+        self.moves = moves;
+        if has_params {
+            self.params = params;
+        }
+    }
+
     /// A path of `moves` for a ball of radius `tool_radius_mm`, without planner details.
     pub fn new(tool_radius_mm: f64, moves: Vec<Move>) -> Self {
         Toolpath {
