@@ -482,7 +482,7 @@ fn clear_axis(
     hit: &Point3,
 ) -> Option<Vector3> {
     let away = (c.y - hit.y).atan2(c.x - hit.x);
-    let hint = (prev.z < 1.0 - 1e-12).then(|| prev.z.clamp(-1.0, 1.0).acos());
+    let hint = (prev.z < 1.0 - VERTICAL_COS_SLACK).then(|| prev.z.clamp(-1.0, 1.0).acos());
     // Keep turning the way the previous point did, at the least tilt clear that way, even
     // where another way needs less: the axis then does not swing round between
     // neighbouring points (on the head at h = 0.05 mm, switching to a way needing 5° less
