@@ -521,7 +521,7 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
     let mut opts = PlanOptions::default()
         .with_tool_radius(1.0)
         .with_scallop(0.3);
-    opts.max_tilt_deg = 90.0;
+    opts.max_tilt_deg = 120.0;
     opts.start_patch = Some(1);
     let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
     let path = &planned.toolpath;
@@ -563,4 +563,42 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
         "head from patch 1: {} air moves routed round the head, {checked} checked, least ball-centre clearance {least:.4} mm (r {r} mm)",
         air.escaped
     );
+}
+
+#[test]
+fn the_tool_always_comes_from_the_side_the_surface_faces() {
+    // The head's flat bottom faces straight down: no axis within 90° of +Z comes from below
+    // it (a vertical tool there would run up through the part, its shank inside the head
+    // where no surface sample can see it), so planning within 90° must fail and say where.
+    let m = samples::load_sample("head").unwrap();
+    let mut opts = PlanOptions::default()
+        .with_tool_radius(1.0)
+        .with_scallop(0.3);
+    opts.max_tilt_deg = 90.0;
+    let err = isoparametric::plan(&m, &opts, &mut |_| true)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("within 90° of +Z") && err.contains("allow more tilt"),
+        "{err}"
+    );
+    // A table tilting past upright presents the bottom: then every cut point's axis lies
+    // on the side of its contact normal (from the contact to the ball centre).
+    opts.max_tilt_deg = 120.0;
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+    let mut least: f64 = 1.0;
+    let mut below_horizontal = 0;
+    for mv in &planned.toolpath.moves {
+        if !matches!(mv.kind, MoveKind::Feed | MoveKind::Link) {
+            continue;
+        }
+        let n = (mv.cl_point - mv.cc_point).normalize();
+        least = least.min(mv.tool_axis.dot(&n));
+        if mv.tool_axis.z < 0.0 {
+            below_horizontal += 1;
+        }
+    }
+    println!("head, tilt ≤ 120°: least axis·normal {least:.4}, {below_horizontal} cut points with the tool below the horizontal; 90°: {err}");
+    assert!(least > 0.0, "a tool axis points into the surface: {least}");
+    assert!(below_horizontal > 0, "the bottom needs the tool from below");
 }

@@ -466,8 +466,8 @@ fn planned_paths_keep_their_scallop_and_do_not_gouge() {
     }
 }
 
-/// The closed head, planned five-axis (tilts up to 90°: the underside is reached with the
-/// tool sideways), at the paper's h = 0.01 mm with r = 0.5 mm: every sample is reached,
+/// The closed head, planned five-axis (tilts up to 120°, as a trunnion table tilting past
+/// upright: the flat bottom is reached with the tool from below the horizontal), at the paper's h = 0.01 mm with r = 0.5 mm: every sample is reached,
 /// no scallop above h, and nothing cut below the surface, the retract after the last cut
 /// (which straight up would pass through the head above it) included.
 #[test]
@@ -475,7 +475,7 @@ fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
     let (r, h) = (0.5, 0.01);
     let m = samples::load_sample("head").unwrap();
     let mut opts = PlanOptions::default().with_tool_radius(r).with_scallop(h);
-    opts.max_tilt_deg = 90.0;
+    opts.max_tilt_deg = 120.0;
     let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
     let air = planned.axes.air;
     assert_eq!(air.blocked, 0, "every retract and approach finds a way out");

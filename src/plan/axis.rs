@@ -25,6 +25,43 @@ const AZIMUTHS: usize = 12;
 const TILT_STEP_DEG: f64 = 5.0;
 /// Bisection steps refining the tilt (5° / 2^6 ≈ 0.08°).
 const TILT_BISECTIONS: usize = 6;
+/// Least cosine between the tool axis and the surface normal at the contact point: the
+/// tool must come from the side the surface faces (else its flutes and shank run into the
+/// part behind the contact, as under a closed part's bottom) (cos 88°).
+const MIN_AXIS_NORMAL_COS: f64 = 0.035;
+
+/// True if `axis` comes from the side the surface faces at the contact (unit normal `n`)
+/// and the shank and holder along it at ball centre `c` are clear.
+fn usable(
+    obs: &Clearance,
+    (c, n): (&Point3, &Vector3),
+    axis: &Vector3,
+    opts: &PlanOptions,
+) -> bool {
+    axis.dot(n) >= MIN_AXIS_NORMAL_COS && obs.clear(c, axis, opts)
+}
+
+/// The sample the vertical tool at ball centre `c` hits, or the contact point `cc` itself
+/// where the surface faces away from +Z.
+fn vertical_hit(
+    obs: &Clearance,
+    (c, n): (&Point3, &Vector3),
+    cc: &Point3,
+    opts: &PlanOptions,
+) -> Option<Point3> {
+    if n.z < MIN_AXIS_NORMAL_COS {
+        return Some(*cc);
+    }
+    obs.hit(c, &Vector3::z(), opts)
+}
+
+/// Unit contact normal of a move (from the contact point to the ball centre).
+fn contact_normal(m: &Move) -> Vector3 {
+    (m.cl_point - m.cc_point)
+        .try_normalize(AXIS_MIN_NORM)
+        .unwrap_or_else(Vector3::z)
+}
+
 /// Azimuths either side of "away from the obstacle" also tried (radians, 30°).
 const SIDE_AZIMUTH: f64 = std::f64::consts::FRAC_PI_6;
 
@@ -426,14 +463,14 @@ fn tilted(theta: f64, phi: f64) -> Vector3 {
 /// a clear tilt costs a few tests instead of a scan from zero.
 fn least_tilt(
     obs: &Clearance,
-    c: &Point3,
+    (c, n): (&Point3, &Vector3),
     opts: &PlanOptions,
     phi: f64,
     hint: Option<f64>,
 ) -> Option<f64> {
     let max = opts.max_tilt_deg.to_radians();
     let step = TILT_STEP_DEG.to_radians();
-    let clear = |t: f64| obs.clear(c, &tilted(t, phi), opts);
+    let clear = |t: f64| usable(obs, (c, n), &tilted(t, phi), opts);
     // `hi` clear, `lo` not (or zero, where the vertical was found not clear).
     let (mut lo, mut hi) = match hint.map(|h| h.max(step).min(max)) {
         Some(h) if clear(h) => {
@@ -476,7 +513,7 @@ fn least_tilt(
 /// failing those, around the circle.
 fn clear_axis(
     obs: &Clearance,
-    c: &Point3,
+    (c, n): (&Point3, &Vector3),
     opts: &PlanOptions,
     prev: &Vector3,
     hit: &Point3,
@@ -496,7 +533,9 @@ fn clear_axis(
             let sides: &[f64] = if k == 0 { &[0.0] } else { &[turn, -turn] };
             sides
                 .iter()
-                .filter_map(|&d| least_tilt(obs, c, opts, phi0 + d, hint).map(|t| (t, phi0 + d)))
+                .filter_map(|&d| {
+                    least_tilt(obs, (c, n), opts, phi0 + d, hint).map(|t| (t, phi0 + d))
+                })
                 .min_by(|a, b| a.0.total_cmp(&b.0))
         })
     });
@@ -506,13 +545,13 @@ fn clear_axis(
         .or_else(|| {
             [away, away + SIDE_AZIMUTH, away - SIDE_AZIMUTH]
                 .iter()
-                .filter_map(|&phi| least_tilt(obs, c, opts, phi, hint).map(|t| (t, phi)))
+                .filter_map(|&phi| least_tilt(obs, (c, n), opts, phi, hint).map(|t| (t, phi)))
                 .min_by(|a, b| a.0.total_cmp(&b.0))
         })
         .or_else(|| {
             (0..AZIMUTHS).find_map(|k| {
                 let phi = away + k as f64 * std::f64::consts::TAU / AZIMUTHS as f64;
-                least_tilt(obs, c, opts, phi, None).map(|t| (t, phi))
+                least_tilt(obs, (c, n), opts, phi, None).map(|t| (t, phi))
             })
         })?;
     Some(tilted(chosen.0, chosen.1))
@@ -565,8 +604,11 @@ fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool
     (1..poses).any(|k| {
         let s = k as f64 / poses as f64;
         let c = a.cl_point + (b.cl_point - a.cl_point) * s;
+        let n = (contact_normal(a) * (1.0 - s) + contact_normal(b) * s)
+            .try_normalize(AXIS_MIN_NORM)
+            .unwrap_or_else(|| contact_normal(b));
         match (a.tool_axis * (1.0 - s) + b.tool_axis * s).try_normalize(AXIS_MIN_NORM) {
-            Some(axis) => !obs.clear(&c, &axis, opts),
+            Some(axis) => !usable(obs, (&c, &n), &axis, opts),
             // Opposite axes: no defined turn, count it.
             None => true,
         }
@@ -598,12 +640,15 @@ fn bridge(
     }
     let cl = Point3::from((a.cl_point.coords + b.cl_point.coords) * 0.5);
     let cc = Point3::from((a.cc_point.coords + b.cc_point.coords) * 0.5);
-    let axis = match obs.hit(&cl, &Vector3::z(), opts) {
+    let n = (contact_normal(a) + contact_normal(b))
+        .try_normalize(AXIS_MIN_NORM)
+        .unwrap_or_else(|| contact_normal(b));
+    let axis = match vertical_hit(obs, (&cl, &n), &cc, opts) {
         None => Some(Vector3::z()),
         Some(h) => (a.tool_axis + b.tool_axis)
             .try_normalize(AXIS_MIN_NORM)
-            .filter(|x| obs.clear(&cl, x, opts))
-            .or_else(|| clear_axis(obs, &cl, opts, &a.tool_axis, &h)),
+            .filter(|x| usable(obs, (&cl, &n), x, opts))
+            .or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
     };
     let Some(axis) = axis else {
         return false;
@@ -671,7 +716,6 @@ pub fn assign(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<AxisStats> {
-    let r = path.tool_radius_mm;
     let obs = Clearance::new(model, opts);
     let n = path.moves.len();
     let on_surface = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
@@ -684,10 +728,10 @@ pub fn assign(
             continue;
         }
         let c = m.cl_point;
+        let normal = contact_normal(&m);
         let mut axis = Vector3::z();
         if opts.lead_deg != 0.0 || opts.tilt_deg != 0.0 {
             // Lead and tilt are taken from the surface normal in the feed frame.
-            let normal = (m.cl_point - m.cc_point) / r;
             let next = path
                 .moves
                 .get(i + 1)
@@ -709,18 +753,18 @@ pub fn assign(
             let side = normal.cross(&feed);
             let a = rotate(&normal, &side, opts.lead_deg.to_radians());
             let a = rotate(&a, &feed, opts.tilt_deg.to_radians());
-            if obs.clear(&c, &a, opts) {
+            if usable(&obs, (&c, &normal), &a, opts) {
                 axis = a;
             }
         }
-        let vertical_hit = if axis == Vector3::z() {
-            obs.hit(&c, &axis, opts)
+        let blocked_at = if axis == Vector3::z() {
+            vertical_hit(&obs, (&c, &normal), &m.cc_point, opts)
         } else {
             None
         };
-        if let Some(h) = vertical_hit {
+        if let Some(h) = blocked_at {
             match (opts.max_tilt_deg > 0.0)
-                .then(|| clear_axis(&obs, &c, opts, &prev, &h))
+                .then(|| clear_axis(&obs, (&c, &normal), opts, &prev, &h))
                 .flatten()
             {
                 Some(a) => {
@@ -771,7 +815,7 @@ pub fn assign(
                 stats.blocked, p.x, p.y, p.z
             ),
             message: format!(
-                "the shank or holder hits the model for every tool axis within {}° of +Z: use a longer shank, a smaller holder or allow more tilt",
+                "no tool axis within {}° of +Z both comes from the side the surface faces and keeps the shank and holder clear of the model: use a longer shank, a smaller holder or allow more tilt (a table tilting past upright reaches undersides)",
                 opts.max_tilt_deg
             ),
         });

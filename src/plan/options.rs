@@ -186,10 +186,13 @@ impl PlanOptions {
                 ));
             }
         }
-        if !(self.max_tilt_deg.is_finite() && (0.0..=90.0).contains(&self.max_tilt_deg)) {
+        if !(self.max_tilt_deg.is_finite() && (0.0..=MAX_TILT_DEG).contains(&self.max_tilt_deg)) {
             return Err(Error::param(
                 "max_tilt_deg",
-                format!("must be between 0° and 90°, got {}", self.max_tilt_deg),
+                format!(
+                    "must be between 0° and {MAX_TILT_DEG}°, got {}",
+                    self.max_tilt_deg
+                ),
             ));
         }
         if self.holder_radius_mm < self.shank_radius() {
@@ -214,3 +217,8 @@ impl PlanOptions {
         Ok(())
     }
 }
+
+/// Largest tool-axis tilt from +Z a plan may ask for (degrees): beyond 90° the tool comes
+/// from below the horizontal, as a swivelling table tilted past upright presents a part's
+/// underside; the machine's own limits then decide (its post says which axis overruns).
+pub const MAX_TILT_DEG: f64 = 135.0;
