@@ -510,6 +510,15 @@ fn segment_clearance(samples: &[Point3], a: &Point3, b: &Point3) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The head with coarse five-axis settings (r 1 mm, h 0.3 mm) tilting up to `max_tilt_deg`.
+fn coarse_head(max_tilt_deg: f64) -> (Model, PlanOptions) {
+    let mut opts = PlanOptions::default()
+        .with_tool_radius(1.0)
+        .with_scallop(0.3);
+    opts.max_tilt_deg = max_tilt_deg;
+    (samples::load_sample("head").unwrap(), opts)
+}
+
 #[test]
 fn air_moves_keep_the_ball_out_of_the_closed_head() {
     // Starting on patch 1 the first cut lies under the head's overhang: coming straight down
@@ -517,11 +526,7 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
     // after a last cut under the overhang is `verify.rs`'s head test), and every air move's
     // ball must stay clear of the surface (checked against dense surface samples, without
     // the planner's index).
-    let m = samples::load_sample("head").unwrap();
-    let mut opts = PlanOptions::default()
-        .with_tool_radius(1.0)
-        .with_scallop(0.3);
-    opts.max_tilt_deg = 120.0;
+    let (m, mut opts) = coarse_head(120.0);
     opts.start_patch = Some(1);
     let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
     let path = &planned.toolpath;
@@ -570,11 +575,7 @@ fn the_tool_always_comes_from_the_side_the_surface_faces() {
     // The head's flat bottom faces straight down: no axis within 90° of +Z comes from below
     // it (a vertical tool there would run up through the part, its shank inside the head
     // where no surface sample can see it), so planning within 90° must fail and say where.
-    let m = samples::load_sample("head").unwrap();
-    let mut opts = PlanOptions::default()
-        .with_tool_radius(1.0)
-        .with_scallop(0.3);
-    opts.max_tilt_deg = 90.0;
+    let (m, mut opts) = coarse_head(90.0);
     let err = isoparametric::plan(&m, &opts, &mut |_| true)
         .unwrap_err()
         .to_string();

@@ -122,25 +122,27 @@ pub fn route(model: &Model, path: &mut Toolpath, opts: &PlanOptions, obs: &Clear
     if sweep.rad <= 0.0 {
         return stats;
     }
-    let on_surface = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
     let blocked = |stats: &mut AirStats, p: Point3| {
         stats.blocked += 1;
         stats.first_blocked.get_or_insert(p);
     };
-    let old = path.moves.clone();
-    let old_params = path.params.clone();
-    path.rebuild(|i, add| {
-        let m = old[i];
-        let param = old_params.get(i).copied().unwrap_or_default();
+    path.rebuild(|old, i, add| {
+        let m = old.moves[i];
+        let param = old.param(i);
         let mut push = |mv: Move| add(mv, param);
         // The cut this air move leaves (the first retract after a cut) or comes down to (the
         // rapid above the next cut, before its plunge).
         let cut = match m.kind {
-            MoveKind::Retract if i > 0 && on_surface(old[i - 1].kind) => {
-                Some((old[i - 1], Leg::Leaving))
+            MoveKind::Retract if i > 0 && old.moves[i - 1].kind.on_surface() => {
+                Some((old.moves[i - 1], Leg::Leaving))
             }
-            MoveKind::Rapid if old.get(i + 1).is_some_and(|x| x.kind == MoveKind::Plunge) => {
-                Some((old[i + 1], Leg::Arriving))
+            MoveKind::Rapid
+                if old
+                    .moves
+                    .get(i + 1)
+                    .is_some_and(|x| x.kind == MoveKind::Plunge) =>
+            {
+                Some((old.moves[i + 1], Leg::Arriving))
             }
             _ => None,
         };

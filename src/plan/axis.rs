@@ -222,7 +222,7 @@ impl Obstacles {
     /// A sample closer than `rad` to the segment from `p0` to `p1` (the ball swept along it),
     /// if there is one. Samples stand for the surface only to within the sampling gap, so a
     /// touch shallower than that may go unseen.
-    pub fn capsule_hit(&self, p0: &Point3, p1: &Point3, rad: f64) -> Option<Point3> {
+    fn capsule_hit(&self, p0: &Point3, p1: &Point3, rad: f64) -> Option<Point3> {
         let d = p1 - p0;
         let len2 = d.norm_squared();
         let test = |q: &Point3| {
@@ -601,12 +601,13 @@ fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool
         return false;
     }
     let poses = (turn / step).ceil() as usize;
+    let (na, nb) = (contact_normal(a), contact_normal(b));
     (1..poses).any(|k| {
         let s = k as f64 / poses as f64;
         let c = a.cl_point + (b.cl_point - a.cl_point) * s;
-        let n = (contact_normal(a) * (1.0 - s) + contact_normal(b) * s)
+        let n = (na * (1.0 - s) + nb * s)
             .try_normalize(AXIS_MIN_NORM)
-            .unwrap_or_else(|| contact_normal(b));
+            .unwrap_or(nb);
         match (a.tool_axis * (1.0 - s) + b.tool_axis * s).try_normalize(AXIS_MIN_NORM) {
             Some(axis) => !usable(obs, (&c, &n), &axis, opts),
             // Opposite axes: no defined turn, count it.
@@ -670,17 +671,16 @@ fn bridge(
 /// the shank or holder into the model (see [`bridge`]); counts the splits and the turns
 /// that stay blocked.
 fn bridge_turns(path: &mut Toolpath, obs: &Clearance, opts: &PlanOptions, stats: &mut AxisStats) {
-    let on_surface = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
-    let old = path.moves.clone();
-    let old_params = path.params.clone();
-    path.rebuild(|i, add| {
-        let b = old[i];
-        let q = old_params.get(i).copied().unwrap_or_default();
-        if i > 0 && on_surface(old[i - 1].kind) && matches!(b.kind, MoveKind::Feed | MoveKind::Link)
+    path.rebuild(|old, i, add| {
+        let b = old.moves[i];
+        let q = old.param(i);
+        if i > 0
+            && old.moves[i - 1].kind.on_surface()
+            && matches!(b.kind, MoveKind::Feed | MoveKind::Link)
         {
             let mut inserted = Vec::new();
             let clear = bridge(
-                &old[i - 1],
+                &old.moves[i - 1],
                 &b,
                 (0.0, 1.0),
                 obs,
@@ -691,7 +691,7 @@ fn bridge_turns(path: &mut Toolpath, obs: &Clearance, opts: &PlanOptions, stats:
             if !inserted.is_empty() {
                 stats.bridged += 1;
             }
-            let qa = old_params.get(i - 1).copied().unwrap_or_default();
+            let qa = old.param(i - 1);
             for (m, s) in inserted {
                 add(m, [qa[0] + (q[0] - qa[0]) * s, qa[1] + (q[1] - qa[1]) * s]);
             }
@@ -718,13 +718,12 @@ pub fn assign(
 ) -> Result<AxisStats> {
     let obs = Clearance::new(model, opts);
     let n = path.moves.len();
-    let on_surface = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge);
     let mut axes: Vec<Vector3> = vec![Vector3::z(); n];
     let mut prev = Vector3::z();
     let mut stats = AxisStats::default();
     for i in 0..n {
         let m = path.moves[i];
-        if !on_surface(m.kind) {
+        if !m.kind.on_surface() {
             continue;
         }
         let c = m.cl_point;
@@ -735,12 +734,12 @@ pub fn assign(
             let next = path
                 .moves
                 .get(i + 1)
-                .filter(|x| on_surface(x.kind))
+                .filter(|x| x.kind.on_surface())
                 .map(|x| x.cc_point);
             let before = i
                 .checked_sub(1)
                 .map(|j| path.moves[j])
-                .filter(|x| on_surface(x.kind))
+                .filter(|x| x.kind.on_surface())
                 .map(|x| x.cc_point);
             let feed = match (before, next) {
                 (_, Some(q)) => q - m.cc_point,
@@ -786,7 +785,7 @@ pub fn assign(
     // Moves off the surface keep the axis of the nearest cut.
     let mut last = None;
     for i in 0..n {
-        if on_surface(path.moves[i].kind) {
+        if path.moves[i].kind.on_surface() {
             last = Some(axes[i]);
         } else if let Some(a) = last {
             axes[i] = a;
@@ -794,7 +793,7 @@ pub fn assign(
     }
     let mut next = None;
     for i in (0..n).rev() {
-        if on_surface(path.moves[i].kind) {
+        if path.moves[i].kind.on_surface() {
             next = Some(axes[i]);
         } else if path.moves[i].kind == MoveKind::Rapid {
             if let Some(a) = next {

@@ -22,6 +22,13 @@ pub enum MoveKind {
     Plunge = 4,
 }
 
+impl MoveKind {
+    /// True for moves that end with the ball on the surface (cutting, linking, plunging).
+    pub fn on_surface(self) -> bool {
+        matches!(self, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge)
+    }
+}
+
 /// One position of the tool; the move *ends* here.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Move {
@@ -71,6 +78,21 @@ pub struct Toolpath {
     pub params: Vec<[f64; 2]>,
 }
 
+/// The moves a [`Toolpath::rebuild`] replaces, with their patch parameters (empty where
+/// the path has none).
+#[derive(Clone, Copy)]
+pub struct OldMoves<'a> {
+    pub moves: &'a [Move],
+    pub params: &'a [[f64; 2]],
+}
+
+impl OldMoves<'_> {
+    /// Patch parameters of old move `i` (zero where the path has none).
+    pub fn param(&self, i: usize) -> [f64; 2] {
+        self.params.get(i).copied().unwrap_or_default()
+    }
+}
+
 /// Summary of a tool path (keys as in the JSON report).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlanReport {
@@ -99,19 +121,30 @@ pub struct PlanReport {
 pub const RAPID_MM_MIN: f64 = 5000.0;
 
 impl Toolpath {
-    /// Rebuilds the moves: `f(i, add)` adds, through `add(move, params)`, the moves that
-    /// replace old move `i` (at least one each, the last standing for it). Keeps `runs` and
-    /// `params` in step; `params` of added moves are used only where the path has them.
-    pub fn rebuild(&mut self, mut f: impl FnMut(usize, &mut dyn FnMut(Move, [f64; 2]))) {
+    /// Rebuilds the moves: `f(old, i, add)` adds, through `add(move, params)`, the moves
+    /// that replace old move `i` (`old` holds the old moves and their params, the latter
+    /// empty where the path has none; at least one move each, the last standing for it).
+    /// Keeps `runs` and `params` in step.
+    pub fn rebuild(&mut self, mut f: impl FnMut(OldMoves, usize, &mut dyn FnMut(Move, [f64; 2]))) {
         let n = self.moves.len();
         let has_params = self.params.len() == n;
+        let old_moves = std::mem::take(&mut self.moves);
+        let old_params = if has_params {
+            std::mem::take(&mut self.params)
+        } else {
+            Vec::new()
+        };
+        let old = OldMoves {
+            moves: &old_moves,
+            params: &old_params,
+        };
         let mut moves: Vec<Move> = Vec::with_capacity(n);
         let mut params: Vec<[f64; 2]> = Vec::with_capacity(self.params.len());
         // First and last new index of each old move.
         let mut new_index = vec![(0usize, 0usize); n];
         for (i, slot) in new_index.iter_mut().enumerate() {
             let first = moves.len();
-            f(i, &mut |m, q| {
+            f(old, i, &mut |m, q| {
                 moves.push(m);
                 if has_params {
                     params.push(q);
@@ -120,13 +153,11 @@ impl Toolpath {
             debug_assert!(moves.len() > first, "move {i} was dropped");
             *slot = (first, moves.len().max(first + 1) - 1);
         }
-        if moves.len() == n {
-            self.moves = moves;
-            return;
-        }
-        for run in &mut self.runs {
-            run.first_move = new_index[run.first_move].0;
-            run.last_move = new_index[run.last_move].1;
+        if moves.len() != n {
+            for run in &mut self.runs {
+                run.first_move = new_index[run.first_move].0;
+                run.last_move = new_index[run.last_move].1;
+            }
         }
         self.moves = moves;
         if has_params {
