@@ -215,3 +215,73 @@ fn malformed_empty_sides_are_rejected() {
     let e = TMesh::try_new(points(), &faces([0, 1, 1, 2]), &k, 1.0, Scheme::TSpline).unwrap_err();
     assert!(e.to_string().contains("opposite sides disagree"), "{e}");
 }
+
+/// The same mesh with the second line (B1' to A1 and to C1) marked as a fan line: the double
+/// knot at s = 1 belongs to the block B1 B1' only.
+fn fan_mesh() -> TMesh {
+    TMesh::try_new_with_fan_lines(
+        points(),
+        &faces([0, 1, 1, 2]),
+        &knots(),
+        1.0,
+        Scheme::TSpline,
+        &[(A1, B1P), (C1, B1P)],
+    )
+    .unwrap()
+}
+
+#[test]
+fn rays_cross_a_fan_line_unseen_but_still_run_along_it() {
+    let m = fan_mesh();
+    // D0's ray to +s crosses SW (1), then the fan line unseen, then SE (1): single knots.
+    assert_knots(
+        &m,
+        D0,
+        [0.0, 0.0, 0.0, 1.0, 2.0],
+        [-0.5, -0.5, 0.0, 0.5, 1.5],
+    );
+    // Rays along the block and along the fan lines are as before.
+    assert_knots(
+        &m,
+        B1P,
+        [-1.0, 0.0, 0.0, 1.0, 1.0],
+        [-1.0, -1.0, 0.0, 1.0, 1.0],
+    );
+    assert_knots(
+        &m,
+        B1,
+        [-1.0, -1.0, 0.0, 0.0, 1.0],
+        [-1.0, -1.0, 0.0, 1.0, 1.0],
+    );
+    assert_knots(
+        &m,
+        A1,
+        [-1.0, -1.0, 0.0, 1.0, 1.0],
+        [0.0, 0.0, 0.0, 1.0, 2.0],
+    );
+    // The surface stays continuous across the fan.
+    let flags = vec![false; m.vertex_count()];
+    let blends = m.face_blends(&flags, &flags);
+    for k in 1..10 {
+        let v = 0.2 + 0.6 * k as f64 / 10.0;
+        let a = eval(&m, &blends, 0, 1.0, v);
+        let b = eval(&m, &blends, 1, 0.0, v);
+        assert!((a - b).norm() < 1e-12, "t = {v}: {a} vs {b}");
+    }
+}
+
+#[test]
+fn a_fan_line_must_be_an_inner_edge() {
+    for bad in [(A0, C2), (A0, A1)] {
+        let e = TMesh::try_new_with_fan_lines(
+            points(),
+            &faces([0, 1, 1, 2]),
+            &knots(),
+            1.0,
+            Scheme::TSpline,
+            &[bad],
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("fan line"), "{bad:?}: {e}");
+    }
+}

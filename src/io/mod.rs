@@ -1,4 +1,4 @@
-//! Readers and writers of model files. Readers turn bytes into a validated [`TMesh`]
+//! Readers and writers of model files. Readers turn bytes into a validated [`TMesh`](crate::tmesh::TMesh)
 //! wrapped in a [`Model`]; they never evaluate the surface themselves.
 //!
 //! Formats: the project's JSON T-mesh ([`json`]) and Autodesk T-Splines `.tsm` files

@@ -39,8 +39,10 @@
 //! corner) or the block's outer row (at a T-junction). Each file edge becomes a strip of
 //! zero width between the faces on its two sides, split by one knot line per row of the two
 //! blocks at its ends; where the two ends have different numbers of rows, the extra lines fan
-//! into the outermost common one (zero-area faces with an empty side). Walking this mesh gives
-//! each grip the repeated knots its block stands for.
+//! into the outermost common one (zero-area faces with an empty side); they are fan lines of
+//! the T-mesh, which a crossing ray does not see, since the repeated knot they carry belongs to
+//! the block only. Walking this mesh gives each grip the repeated knots its block stands for
+//! (the same knot vectors as GrapeTec/T-SPLINE's reader, `tests/tsm.rs`).
 
 use crate::error::{Error, Result};
 use crate::geom::Point3;
@@ -1155,6 +1157,8 @@ struct Builder<'a> {
     blocks: &'a [Option<Block>],
     faces: Vec<FaceLoop>,
     knots: HashMap<(u32, u32), f64>,
+    /// Strip lines that fan into the far end (see [`crate::tmesh`]).
+    fan_lines: Vec<(u32, u32)>,
 }
 
 impl Builder<'_> {
@@ -1314,11 +1318,17 @@ impl Builder<'_> {
         lines.sort_unstable();
         lines.dedup();
         let mut ids = Vec::with_capacity(lines.len());
-        for &(jv, ju) in &lines {
+        for (i, &(jv, ju)) in lines.iter().enumerate() {
             let a = self.grip(v, pos(bv, dv, jv, dv + 1), line, &why)?;
             let b = self.grip(u, pos(bu, du, -ju, du + 1), line, &why)?;
             self.knot(a, b, interval, line)?;
             ids.push((a, b));
+            // A row of one end's block only: it fans into the other end. The mesh boundary
+            // stays a knot line whatever the rows.
+            let on_boundary = (i == 0 && !right) || (i + 1 == lines.len() && !left);
+            if jv != ju && !on_boundary {
+                self.fan_lines.push((a, b));
+            }
         }
         for w in 0..lines.len() - 1 {
             let ((a1, b1), (a2, b2)) = (lines[w], lines[w + 1]);
@@ -1367,6 +1377,7 @@ pub fn read(bytes: &[u8]) -> Result<(TMesh, TsmMeta)> {
         blocks: &placed.blocks,
         faces: Vec::new(),
         knots: HashMap::new(),
+        fan_lines: Vec::new(),
     };
     for f in 0..p.faces.len() {
         if p.faces[f].rec.is_some() {
@@ -1402,13 +1413,24 @@ pub fn read(bytes: &[u8]) -> Result<(TMesh, TsmMeta)> {
             ),
         ));
     }
-    let Builder { faces, knots, .. } = b;
-    let mesh = TMesh::try_new(placed.points, &faces, &knots, 1.0, Scheme::TSpline).map_err(
-        |e| match e {
-            Error::InvalidMesh(m) => Error::InvalidMesh(format!("built from the .tsm file: {m}")),
-            other => other,
-        },
-    )?;
+    let Builder {
+        faces,
+        knots,
+        fan_lines,
+        ..
+    } = b;
+    let mesh = TMesh::try_new_with_fan_lines(
+        placed.points,
+        &faces,
+        &knots,
+        1.0,
+        Scheme::TSpline,
+        &fan_lines,
+    )
+    .map_err(|e| match e {
+        Error::InvalidMesh(m) => Error::InvalidMesh(format!("built from the .tsm file: {m}")),
+        other => other,
+    })?;
     let mut vertex_of_slot = vec![None; p.vertices.len()];
     for (v, blk) in placed.blocks.iter().enumerate() {
         if let Some(blk) = blk {

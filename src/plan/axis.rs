@@ -90,7 +90,7 @@ pub struct Obstacles {
 impl Obstacles {
     /// Samples the model for collision tests, no two neighbouring samples farther apart
     /// than `spacing` (mm), indexed in cells of about `cell_mm` (at most the model's size
-    /// over [`GRID_CELLS`], at least the sampling gap).
+    /// over `GRID_CELLS`, at least the sampling gap).
     pub fn new(model: &Model, spacing: f64, cell_mm: f64) -> Obstacles {
         let size = model.surface.bbox().diagonal().max(1e-6);
         let chordal = (0.25 * spacing).max(size * 2e-4);
@@ -580,7 +580,7 @@ pub struct AxisStats {
     /// Moves between two cut points whose axis turn was split into smaller clear turns.
     pub bridged: usize,
     /// Moves between two cut points during which the turning tool's shank or holder
-    /// still passes through the model (poses checked every [`SWEEP_STEP_DEG`] of turn).
+    /// still passes through the model (poses checked every `SWEEP_STEP_DEG` of turn).
     pub sweep_hits: usize,
     /// The end of the first of those (ball centre, mm).
     pub first_sweep_hit: Option<Point3>,

@@ -17,6 +17,11 @@
 //! *cusp*, where its two long sides leave one vertex in the same direction: this is how a
 //! stack of repeated knot lines ends, fanning into one vertex (e.g. the repeated knots of a
 //! concave boundary corner with Bézier end conditions). It occupies no angle at the cusp.
+//!
+//! The long sides of such a triangle that leave the stack's other lines are *fan lines*: a
+//! repeated knot line that belongs to the grip block at one end only. It carries that
+//! block's grips to the far vertex (a ray along it meets the far vertex), but a ray crossing
+//! it between its ends meets no knot there: the repeated knot exists only at the block.
 
 pub mod refine;
 pub mod walk;
@@ -111,6 +116,8 @@ pub struct TMesh {
     faces: Vec<Face>,
     /// One outgoing half-edge per vertex; for a boundary vertex the most clockwise one.
     vertex_edge: Vec<u32>,
+    /// Per half-edge: part of a fan line (see the module notes), crossed by rays unseen.
+    fan_line: Vec<bool>,
     scheme: Scheme,
 }
 
@@ -179,6 +186,20 @@ impl TMesh {
         knots: &HashMap<(u32, u32), f64>,
         default_knot: f64,
         scheme: Scheme,
+    ) -> Result<Self> {
+        Self::try_new_with_fan_lines(points, faces, knots, default_knot, scheme, &[])
+    }
+
+    /// As [`TMesh::try_new`], with the edges `(a, b)` (either order) that are fan lines: lines
+    /// of a grip block that end in a fan at the far vertex (see the module notes). Each must
+    /// be an edge of the mesh with a face on both sides.
+    pub fn try_new_with_fan_lines(
+        points: Vec<ControlPoint>,
+        faces: &[FaceLoop],
+        knots: &HashMap<(u32, u32), f64>,
+        default_knot: f64,
+        scheme: Scheme,
+        fan_lines: &[(u32, u32)],
     ) -> Result<Self> {
         let nv = points.len();
         for (i, p) in points.iter().enumerate() {
@@ -293,6 +314,20 @@ impl TMesh {
                 half_edges[h as usize].twin = Some(t);
             }
         }
+        let mut fan_line = vec![false; half_edges.len()];
+        for &(a, b) in fan_lines {
+            match (directed.get(&(a, b)), directed.get(&(b, a))) {
+                (Some(&h), Some(&t)) => {
+                    fan_line[h as usize] = true;
+                    fan_line[t as usize] = true;
+                }
+                _ => {
+                    return Err(Error::InvalidMesh(format!(
+                        "fan line {a}-{b} is not an edge with a face on both sides"
+                    )))
+                }
+            }
+        }
         if let Some(v) = used.iter().position(|u| !u) {
             return Err(Error::InvalidMesh(format!(
                 "vertex {v} is not used by any face"
@@ -312,6 +347,7 @@ impl TMesh {
             half_edges,
             faces: out_faces,
             vertex_edge,
+            fan_line,
             scheme,
         };
         for v in 0..nv {
@@ -357,6 +393,11 @@ impl TMesh {
     #[inline]
     pub fn he(&self, h: u32) -> &HalfEdge {
         &self.half_edges[h as usize]
+    }
+
+    /// True if half-edge `h` is part of a fan line: a ray crossing it meets no knot there.
+    pub fn is_fan_line(&self, h: u32) -> bool {
+        self.fan_line[h as usize]
     }
 
     /// Number of vertices.

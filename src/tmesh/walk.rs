@@ -2,7 +2,8 @@
 //!
 //! A ray leaves a vertex in one of its four directions and crosses knot lines: along an edge
 //! it reaches the edge's far vertex; inside a face it crosses to the opposite side. Each
-//! crossing is one bay. Two bays in each direction give the five knots of a cubic blending
+//! crossing is one bay, except a crossing of a fan line between its ends (a repeated knot
+//! that exists only at the grip block it leaves, see [`super`]). Two bays in each direction give the five knots of a cubic blending
 //! function; where the ray leaves the mesh the last knot repeats.
 //!
 //! Everything is topological (sides of faces, quarter turns around vertices) so that zero
@@ -211,6 +212,13 @@ impl TMesh {
             };
             first = false;
             match step {
+                // Crossing a fan line between its ends: no knot there, the ray goes on.
+                Some((d, next @ At::Side { h, .. }))
+                    if self.is_fan_line(h) && self.he(h).twin.is_some() =>
+                {
+                    dist += d;
+                    state = next;
+                }
                 Some((d, next)) => {
                     dist += d;
                     last_step = d;
