@@ -1006,3 +1006,197 @@ proptest! {
         }
     }
 }
+
+/// A `.tsm` file as Fusion writes one: no grip blocks, `end-conditions SUBD_CREASES`, every
+/// vertex `NORTH`, one grip per vertex and no `0m` records, Fusion's header and trailer.
+/// Built here from quadrilaterals (counter-clockwise seen from outside), with outside links
+/// along the boundary of an open grid. Coordinates in metres.
+fn fusion_tsm(points: &[[f64; 3]], quads: &[[usize; 4]]) -> String {
+    struct Link {
+        a: usize,
+        b: usize,
+        face: i64,
+        prev: usize,
+        next: usize,
+        edge: usize,
+        flag: usize,
+    }
+    let mut links: Vec<Link> = Vec::new();
+    let mut edge_of = std::collections::HashMap::new();
+    let mut edges: Vec<usize> = Vec::new();
+    let mut corners = vec![0usize; points.len()];
+    for (f, q) in quads.iter().enumerate() {
+        let base = links.len();
+        for k in 0..4 {
+            let (a, b) = (q[k], q[(k + 1) % 4]);
+            let id = *edge_of.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                edges.push(base + k);
+                edges.len() - 1
+            });
+            corners[a] += 1;
+            links.push(Link {
+                a,
+                b,
+                face: f as i64,
+                prev: base + (k + 3) % 4,
+                next: base + (k + 1) % 4,
+                edge: id,
+                flag: 0,
+            });
+        }
+    }
+    let directed: std::collections::HashMap<(usize, usize), usize> = links
+        .iter()
+        .enumerate()
+        .map(|(i, l)| ((l.a, l.b), i))
+        .collect();
+    let inner = links.len();
+    for i in 0..inner {
+        let (a, b, edge) = (links[i].a, links[i].b, links[i].edge);
+        if !directed.contains_key(&(b, a)) {
+            // Outside link; the outside occupies the quarter turns the faces leave.
+            links.push(Link {
+                a: b,
+                b: a,
+                face: -1,
+                prev: 0,
+                next: 0,
+                edge,
+                flag: 3 - corners[b],
+            });
+        }
+    }
+    let index: std::collections::HashMap<(usize, usize), usize> = links
+        .iter()
+        .enumerate()
+        .map(|(i, l)| ((l.a, l.b), i))
+        .collect();
+    for i in inner..links.len() {
+        let (a, b) = (links[i].a, links[i].b);
+        links[i].next = (inner..links.len()).find(|&j| links[j].a == b).unwrap();
+        links[i].prev = (inner..links.len()).find(|&j| links[j].b == a).unwrap();
+    }
+    let mut out = String::from(
+        "#TS0200\n\ndegree 3\ncap-type G1CAPS\nstar-smoothness 0\nunits 1 meters\nend-conditions SUBD_CREASES\nstar-knot-rule NURCCS\n\n",
+    );
+    for f in 0..quads.len() {
+        out += &format!("f {} 0\n", 4 * f);
+    }
+    for &l in &edges {
+        out += &format!("e {l} 1\n");
+    }
+    for v in 0..points.len() {
+        let l = links.iter().position(|l| l.a == v).unwrap();
+        out += &format!("v {l} NORTH\n");
+    }
+    for l in &links {
+        let opp = index[&(l.b, l.a)];
+        out += &format!(
+            "l {} {} {opp} {} {} {} {}\n",
+            l.prev, l.next, l.a, l.face, l.edge, l.flag
+        );
+    }
+    for p in points {
+        out += &format!("0g {} {} {} 1\n", p[0], p[1], p[2]);
+    }
+    out += "\ntol 1.00000000000000008e-05\ngeom-tol 1.00000000000000008e-05\nver 992\nbehavior-version 14.2.0\ncompat-version 13.3.0\n";
+    out
+}
+
+#[test]
+fn fusion_exports_read_as_catmull_clark_cages() {
+    // An open 4 x 4 grid with one raised point: the same surface as the cage read from OBJ
+    // (Catmull–Clark with sharp boundaries), the file's metres read as millimetres.
+    let n = 4;
+    let mut pts = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            let z = if (x, y) == (1, 2) { 0.004 } else { 0.0 };
+            pts.push([0.01 * x as f64, 0.01 * y as f64 + 0.002 * x as f64, z]);
+        }
+    }
+    let mut quads = Vec::new();
+    for y in 0..n - 1 {
+        for x in 0..n - 1 {
+            let v = y * n + x;
+            quads.push([v, v + 1, v + n + 1, v + n]);
+        }
+    }
+    let tsm = fusion_tsm(&pts, &quads);
+    let mut obj = String::new();
+    for p in &pts {
+        obj += &format!("v {} {} {}\n", p[0] * 1000.0, p[1] * 1000.0, p[2] * 1000.0);
+    }
+    for q in &quads {
+        obj += &format!("f {} {} {} {}\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+    }
+    let a = tspath::io::load(tsm.as_bytes(), "grid").unwrap();
+    let b = tspath::io::load(obj.as_bytes(), "grid").unwrap();
+    assert_eq!(a.summary().units_read, "meters (1 m)");
+    let samples: Vec<_> = (0..b.surface.faces().len())
+        .flat_map(|f| {
+            let s = &b.surface;
+            (0..=16).flat_map(move |i| {
+                (0..=16).map(move |j| {
+                    let (u, v) = (i as f64 / 16.0, j as f64 / 16.0);
+                    (f, u, v, s.subs(f, u, v))
+                })
+            })
+        })
+        .collect();
+    let mut worst = 0.0f64;
+    for f in 0..a.surface.faces().len() {
+        for (u, v) in [(0.0, 0.0), (0.3, 0.7), (0.5, 0.5), (1.0, 0.2), (0.9, 1.0)] {
+            let p = a.surface.subs(f, u, v);
+            worst = worst.max(distance_to_surface(&b.surface, &samples, p));
+        }
+    }
+    println!("Fusion-style grid: {worst:.3e} mm from the OBJ cage's Catmull–Clark surface");
+    assert!(worst < 1e-9, "{worst} mm");
+    // The surface reaches the grid's corners (subdivision creases along the boundary).
+    let corner = Point3::new(30.0, 36.0, 0.0);
+    assert!(distance_to_surface(&a.surface, &samples_of(&a.surface), corner) < 1e-9);
+
+    // A closed box: eight star points (valence 3), read and tessellated.
+    let mut pts = Vec::new();
+    for i in 0..8 {
+        pts.push([
+            0.01 * (i >> 2 & 1) as f64,
+            0.01 * (i >> 1 & 1) as f64,
+            0.01 * (i & 1) as f64,
+        ]);
+    }
+    let v = |x: usize, y: usize, z: usize| 4 * x + 2 * y + z;
+    let quads = [
+        [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
+        [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
+        [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
+        [v(0, 1, 0), v(0, 1, 1), v(1, 1, 1), v(1, 1, 0)],
+        [v(0, 0, 0), v(0, 0, 1), v(0, 1, 1), v(0, 1, 0)],
+        [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
+    ];
+    let m = tspath::io::load(fusion_tsm(&pts, &quads).as_bytes(), "box").unwrap();
+    let s = m.summary();
+    assert_eq!((s.extraordinary_points, s.holes), (8, 0));
+    let t = m.tessellate(0.05);
+    assert!(!t.indices.is_empty() && t.positions.iter().all(|x| x.is_finite()));
+    // Symmetric cage, symmetric limit surface about the box's centre.
+    let bb = m.surface.bbox();
+    for k in 0..3 {
+        assert!((bb.min[k] + bb.max[k] - 10.0).abs() < 1e-9, "{bb:?}");
+        assert!(bb.min[k] > 0.0 && bb.max[k] < 10.0, "{bb:?}");
+    }
+}
+
+fn samples_of(s: &Surface) -> Vec<(usize, f64, f64, Point3)> {
+    (0..s.faces().len())
+        .flat_map(|f| {
+            (0..=8).flat_map(move |i| {
+                (0..=8).map(move |j| {
+                    let (u, v) = (i as f64 / 8.0, j as f64 / 8.0);
+                    (f, u, v, s.subs(f, u, v))
+                })
+            })
+        })
+        .collect()
+}

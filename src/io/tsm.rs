@@ -9,8 +9,9 @@
 //! Lines hold one record each; `#` starts a comment (in any byte encoding). Records of one
 //! kind are numbered by order of appearance, and a record without operands is a deleted slot
 //! that keeps its number.
-//! - Header: `degree 3`, `units <metres per unit> <name>`, `force-bezier-end-conditions`,
-//!   `star-smoothness`, `cap-type`; trailer `tol`, `ver`.
+//! - Header: `degree 3`, `units <metres per unit> <name>`, `force-bezier-end-conditions`
+//!   (T-Splines for Rhino) or `end-conditions` (Fusion: `SUBD_CREASES`), `star-smoothness`,
+//!   `cap-type`; trailer `tol`, `ver` (Fusion adds `geom-tol`, `behavior-version`, ...).
 //! - `f link flag`: a face and one of its links. `e link interval`: an edge and its knot
 //!   interval. `v link DIR`: a vertex, one of its links, and the compass direction (`NORTH`,
 //!   `WEST`, `SOUTH`, `EAST`) that link has in the vertex's own frame.
@@ -86,9 +87,12 @@ pub struct TsmMeta {
     pub metres_per_unit: f64,
     /// `force-bezier-end-conditions` (boundaries interpolate their control polygon).
     pub force_bezier_end_conditions: bool,
-    /// `star-smoothness` and `cap-type` as written (they matter only at extraordinary points).
+    /// `end-conditions` as written (Fusion exports: `SUBD_CREASES`), if present.
+    pub end_conditions: Option<String>,
+    /// `star-smoothness` and `cap-type` as written (they matter only at extraordinary points;
+    /// T-Splines for Rhino writes `cap-type 1`, Fusion `cap-type G1CAPS`).
     pub star_smoothness: i64,
-    pub cap_type: i64,
+    pub cap_type: String,
     /// For each `v` slot, the T-mesh vertex of its main grip (`None`: a deleted slot).
     pub vertex_of_slot: Vec<Option<u32>>,
     /// For each `v` slot, the file's `100001uv` parameters (`None`: absent or empty).
@@ -156,8 +160,9 @@ struct Parsed {
     format_version: String,
     units: Option<(f64, String)>,
     force_bezier: bool,
+    end_conditions: Option<String>,
     star_smoothness: i64,
-    cap_type: i64,
+    cap_type: String,
     faces: Vec<Slot<usize>>,
     edges: Vec<Slot<(usize, f64)>>,
     vertices: Vec<Slot<(usize, usize)>>,
@@ -314,7 +319,6 @@ fn parse(bytes: &[u8]) -> Result<Parsed> {
     let mut p = Parsed {
         format_version: tag,
         star_smoothness: 0,
-        cap_type: 0,
         ..Parsed::default()
     };
     let mut degree = None;
@@ -366,8 +370,12 @@ fn parse(bytes: &[u8]) -> Result<Parsed> {
                 p.star_smoothness = f.int(0, "the smoothness")?;
             }
             "cap-type" => {
-                f.count(1, "an integer")?;
-                p.cap_type = f.int(0, "the cap type")?;
+                f.count(1, "a cap type")?;
+                p.cap_type = f.args[0].to_string();
+            }
+            "end-conditions" => {
+                f.count(1, "an end-condition name")?;
+                p.end_conditions = Some(f.args[0].to_string());
             }
             "f" => {
                 let rec = if empty {
@@ -998,7 +1006,33 @@ struct Placed {
 
 fn place_grips(p: &Parsed, topo: &Topology, mm_per_unit: f64) -> Result<Placed> {
     let ng = p.grips.len();
-    if p.owners.len() != ng {
+    // Without any `0m` grip records (Fusion exports), grip k is the main grip of vertex k.
+    let implicit: Vec<GripOwner>;
+    let owners = if p.owners.is_empty() && p.blocks.is_empty() && ng > 0 {
+        if ng != p.vertices.len() {
+            return Err(perr(
+                p.grips[ng - 1].line,
+                format!(
+                    "the file has no `0m gv`/`0m gvp` records, so its grips are taken one per vertex in order, but there are {ng} `0g` grips and {} `v` records",
+                    p.vertices.len()
+                ),
+            ));
+        }
+        implicit = p
+            .grips
+            .iter()
+            .enumerate()
+            .map(|(k, g)| GripOwner {
+                line: g.line,
+                vertex: g.rec.and(p.vertices[k].rec.map(|_| k)),
+                main: true,
+            })
+            .collect();
+        &implicit
+    } else {
+        &p.owners
+    };
+    if owners.len() != ng {
         let line = p
             .owners
             .last()
@@ -1009,13 +1043,13 @@ fn place_grips(p: &Parsed, topo: &Topology, mm_per_unit: f64) -> Result<Placed> 
             line,
             format!(
                 "there are {ng} `0g` grips but {} `0m gv`/`0m gvp` records; each grip needs one",
-                p.owners.len()
+                owners.len()
             ),
         ));
     }
     // Main grip of each vertex.
     let mut main: Vec<Option<usize>> = vec![None; p.vertices.len()];
-    for (g, o) in p.owners.iter().enumerate() {
+    for (g, o) in owners.iter().enumerate() {
         let Some(v) = o.vertex else { continue };
         if p.grips[g].rec.is_none() {
             return Err(perr(
@@ -1062,7 +1096,7 @@ fn place_grips(p: &Parsed, topo: &Topology, mm_per_unit: f64) -> Result<Placed> 
             for a in 1..=b.dims[k] {
                 for c in 0..=b.dims[(k + 1) % 4] {
                     let Some(&Some(g)) = it.next() else { continue };
-                    let o = &p.owners[g];
+                    let o = &owners[g];
                     if o.vertex != Some(v) || o.main {
                         return Err(perr(
                             b.line,
@@ -1085,7 +1119,7 @@ fn place_grips(p: &Parsed, topo: &Topology, mm_per_unit: f64) -> Result<Placed> 
             }
         }
     }
-    for (g, o) in p.owners.iter().enumerate() {
+    for (g, o) in owners.iter().enumerate() {
         if let (Some(v), None) = (o.vertex, placed_at[g]) {
             return Err(perr(
                 o.line,
@@ -1361,6 +1395,28 @@ impl Builder<'_> {
     }
 }
 
+/// True for a file whose surface is the Catmull–Clark limit of its control grid: no Bézier end
+/// conditions and no grip blocks (Fusion exports, `end-conditions SUBD_CREASES`: boundaries
+/// are subdivision creases), every face a quadrilateral without T-junctions, one knot
+/// interval throughout. T-spline knot rules give the same surface inside such a grid but not
+/// next to its boundary or its star points.
+fn subdivision_cage(p: &Parsed, topo: &Topology) -> bool {
+    if p.force_bezier || !p.blocks.is_empty() {
+        return false;
+    }
+    let mut intervals = p.edges.iter().filter_map(|e| e.rec.map(|(_, k)| k));
+    let Some(first) = intervals.next() else {
+        return false;
+    };
+    first > 0.0
+        && intervals.all(|k| k == first)
+        && topo
+            .loops
+            .iter()
+            .filter(|lp| !lp.is_empty())
+            .all(|lp| lp.len() == 4 && lp.iter().all(|&l| p.link(l).flag == 0))
+}
+
 /// Reads a `.tsm` file into a T-mesh (millimetres) and what else it says.
 pub fn read(bytes: &[u8]) -> Result<(TMesh, TsmMeta)> {
     let p = parse(bytes)?;
@@ -1419,18 +1475,19 @@ pub fn read(bytes: &[u8]) -> Result<(TMesh, TsmMeta)> {
         fan_lines,
         ..
     } = b;
-    let mesh = TMesh::try_new_with_fan_lines(
-        placed.points,
-        &faces,
-        &knots,
-        1.0,
-        Scheme::TSpline,
-        &fan_lines,
-    )
-    .map_err(|e| match e {
-        Error::InvalidMesh(m) => Error::InvalidMesh(format!("built from the .tsm file: {m}")),
-        other => other,
-    })?;
+    let scheme = if subdivision_cage(&p, &topo) {
+        Scheme::CatmullClark
+    } else {
+        Scheme::TSpline
+    };
+    let mesh =
+        TMesh::try_new_with_fan_lines(placed.points, &faces, &knots, 1.0, scheme, &fan_lines)
+            .map_err(|e| match e {
+                Error::InvalidMesh(m) => {
+                    Error::InvalidMesh(format!("built from the .tsm file: {m}"))
+                }
+                other => other,
+            })?;
     let mut vertex_of_slot = vec![None; p.vertices.len()];
     for (v, blk) in placed.blocks.iter().enumerate() {
         if let Some(blk) = blk {
@@ -1446,8 +1503,9 @@ pub fn read(bytes: &[u8]) -> Result<(TMesh, TsmMeta)> {
             units,
             metres_per_unit,
             force_bezier_end_conditions: p.force_bezier,
+            end_conditions: p.end_conditions.clone(),
             star_smoothness: p.star_smoothness,
-            cap_type: p.cap_type,
+            cap_type: p.cap_type.clone(),
             vertex_of_slot,
             uv_records,
             grip_of_vertex: placed.grip_of_vertex,
