@@ -1007,11 +1007,21 @@ proptest! {
     }
 }
 
-/// A `.tsm` file as Fusion writes one: no grip blocks, `end-conditions SUBD_CREASES`, every
-/// vertex `NORTH`, one grip per vertex and no `0m` records, Fusion's header and trailer.
-/// Built here from quadrilaterals (counter-clockwise seen from outside), with outside links
-/// along the boundary of an open grid. Coordinates in metres.
-fn fusion_tsm(points: &[[f64; 3]], quads: &[[usize; 4]]) -> String {
+/// Which software's conventions a synthetic `.tsm` file follows.
+#[derive(Clone, Copy, PartialEq)]
+enum Writer {
+    /// Fusion: `end-conditions SUBD_CREASES`, no `0m` records, coordinates in metres.
+    Fusion,
+    /// T-Splines for Rhino: Bézier end conditions, `0m gvp` grip records, `0m cg` records of
+    /// valence 3 or 5 without extra grips at star points, millimetres.
+    Rhino,
+}
+
+/// A `.tsm` file without grip blocks, every vertex `NORTH`, one grip per vertex, with the
+/// header, grip records and trailer of `writer`. Built here from quadrilaterals
+/// (counter-clockwise seen from outside), with outside links along the boundary of an open
+/// grid. Coordinates in file units.
+fn synthetic_tsm(writer: Writer, points: &[[f64; 3]], quads: &[[usize; 4]]) -> String {
     struct Link {
         a: usize,
         b: usize,
@@ -1076,9 +1086,10 @@ fn fusion_tsm(points: &[[f64; 3]], quads: &[[usize; 4]]) -> String {
         links[i].next = (inner..links.len()).find(|&j| links[j].a == b).unwrap();
         links[i].prev = (inner..links.len()).find(|&j| links[j].b == a).unwrap();
     }
-    let mut out = String::from(
-        "#TS0200\n\ndegree 3\ncap-type G1CAPS\nstar-smoothness 0\nunits 1 meters\nend-conditions SUBD_CREASES\nstar-knot-rule NURCCS\n\n",
-    );
+    let mut out = String::from(match writer {
+        Writer::Fusion => "#TS0200\n\ndegree 3\ncap-type G1CAPS\nstar-smoothness 0\nunits 1 meters\nend-conditions SUBD_CREASES\nstar-knot-rule NURCCS\n\n",
+        Writer::Rhino => "#TS0200\n\ndegree 3\ncap-type 1\nstar-smoothness 0\nunits 0.001 millimeters\nforce-bezier-end-conditions 1\n",
+    });
     for f in 0..quads.len() {
         out += &format!("f {} 0\n", 4 * f);
     }
@@ -1099,7 +1110,21 @@ fn fusion_tsm(points: &[[f64; 3]], quads: &[[usize; 4]]) -> String {
     for p in points {
         out += &format!("0g {} {} {} 1\n", p[0], p[1], p[2]);
     }
-    out += "\ntol 1.00000000000000008e-05\ngeom-tol 1.00000000000000008e-05\nver 992\nbehavior-version 14.2.0\ncompat-version 13.3.0\n";
+    if writer == Writer::Fusion {
+        out += "\ntol 1.00000000000000008e-05\ngeom-tol 1.00000000000000008e-05\nver 992\nbehavior-version 14.2.0\ncompat-version 13.3.0\n";
+        return out;
+    }
+    out += "0m odd-grip-map\n";
+    for v in 0..points.len() {
+        out += &format!("0m gvp {v}\n");
+    }
+    for (v, &n) in corners.iter().enumerate() {
+        let boundary = links.iter().any(|l| l.face < 0 && l.a == v);
+        if !boundary && n != 4 {
+            out += &format!("0m cg {v} {n}{}\n", " 0".repeat(n));
+        }
+    }
+    out += "\ntol 1.0000000000000001e-05\nver 904\n";
     out
 }
 
@@ -1122,7 +1147,7 @@ fn fusion_exports_read_as_catmull_clark_cages() {
             quads.push([v, v + 1, v + n + 1, v + n]);
         }
     }
-    let tsm = fusion_tsm(&pts, &quads);
+    let tsm = synthetic_tsm(Writer::Fusion, &pts, &quads);
     let mut obj = String::new();
     for p in &pts {
         obj += &format!("v {} {} {}\n", p[0] * 1000.0, p[1] * 1000.0, p[2] * 1000.0);
@@ -1175,7 +1200,11 @@ fn fusion_exports_read_as_catmull_clark_cages() {
         [v(0, 0, 0), v(0, 0, 1), v(0, 1, 1), v(0, 1, 0)],
         [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
     ];
-    let m = tspath::io::load(fusion_tsm(&pts, &quads).as_bytes(), "box").unwrap();
+    let m = tspath::io::load(
+        synthetic_tsm(Writer::Fusion, &pts, &quads).as_bytes(),
+        "box",
+    )
+    .unwrap();
     let s = m.summary();
     assert_eq!((s.extraordinary_points, s.holes), (8, 0));
     let t = m.tessellate(0.05);
@@ -1199,4 +1228,56 @@ fn samples_of(s: &Surface) -> Vec<(usize, f64, f64, Point3)> {
             })
         })
         .collect()
+}
+
+#[test]
+fn star_points_of_t_splines_for_rhino_are_read() {
+    // A closed box in T-Splines for Rhino's conventions: its eight corners are star points of
+    // valence 3 (`0m cg V 3 0 0 0`). Read as a T-spline, every face touches a star point and
+    // is evaluated by subdivision: the same surface as the box read as a Fusion cage.
+    let mut pts = Vec::new();
+    for i in 0..8 {
+        pts.push([
+            10.0 * (i >> 2 & 1) as f64,
+            10.0 * (i >> 1 & 1) as f64,
+            10.0 * (i & 1) as f64,
+        ]);
+    }
+    let v = |x: usize, y: usize, z: usize| 4 * x + 2 * y + z;
+    let quads = [
+        [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
+        [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
+        [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
+        [v(0, 1, 0), v(0, 1, 1), v(1, 1, 1), v(1, 1, 0)],
+        [v(0, 0, 0), v(0, 0, 1), v(0, 1, 1), v(0, 1, 0)],
+        [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
+    ];
+    let text = synthetic_tsm(Writer::Rhino, &pts, &quads);
+    assert_eq!(text.matches("0m cg").count(), 8);
+    let (mesh, meta) = tsm::read(text.as_bytes()).unwrap();
+    assert!(meta.force_bezier_end_conditions);
+    assert_eq!(mesh.scheme(), tspath::tmesh::Scheme::TSpline);
+    let rhino = tspath::io::load(text.as_bytes(), "box").unwrap();
+    assert_eq!(rhino.summary().extraordinary_points, 8);
+    let metres: Vec<[f64; 3]> = pts.iter().map(|p| p.map(|x| x / 1000.0)).collect();
+    let fusion = tspath::io::load(
+        synthetic_tsm(Writer::Fusion, &metres, &quads).as_bytes(),
+        "box",
+    )
+    .unwrap();
+    let samples = samples_of(&fusion.surface);
+    let mut worst = 0.0f64;
+    for f in 0..rhino.surface.faces().len() {
+        for (u, v) in [(0.0, 0.0), (0.3, 0.7), (0.5, 0.5), (1.0, 0.2)] {
+            let p = rhino.surface.subs(f, u, v);
+            worst = worst.max(distance_to_surface(&fusion.surface, &samples, p));
+        }
+    }
+    println!("Rhino-style box with 8 star points: {worst:.3e} mm from the Catmull–Clark box");
+    assert!(worst < 1e-9, "{worst} mm");
+    // A star point with extra grips (Bézier end conditions or creases there) is refused
+    // with a reason.
+    let bad = text.replacen("0m cg 0 3 0 0 0", "0m cg 0 3 1 0 0 7", 1);
+    let e = tsm::read(bad.as_bytes()).unwrap_err().to_string();
+    assert!(e.contains("star point"), "{e}");
 }

@@ -27,6 +27,7 @@
 //!   N, W, S, E (counter-clockwise) a wedge listing the grips `a` steps along k and `b` steps
 //!   along the next direction, `a` in 1..=d_k then `b` in 0..=d_(k+1); -1 is a hole (the
 //!   outside quadrant of a concave corner). Blocks encode Bézier end conditions and creases.
+//!   A star point writes `0m cg V n 0 … 0` (valence n, no extra grips): a plain vertex.
 //! - `ec edge c`: an edge condition, `c` = 0 on boundary edges (kept in
 //!   [`TsmMeta::edge_conditions`]; creases themselves come from grip blocks).
 //! - `100001uv s t`: parameters of each vertex slot (kept for checking, see
@@ -54,6 +55,9 @@ const FORMAT: &str = "tsm";
 
 /// Largest block extent accepted in one direction of a `cg` record (files use 0 or 1).
 const MAX_BLOCK_EXTENT: i64 = 64;
+
+/// Largest valence of a star point's `cg` record accepted.
+const MAX_STAR_VALENCE: i64 = 64;
 
 /// Millimetres per metre (the `units` record gives metres per file unit).
 const MM_PER_M: f64 = 1000.0;
@@ -584,8 +588,17 @@ impl Parsed {
                 let vertex = f.int(1, "the vertex")?;
                 let valence = f.int(2, "the valence")?;
                 if valence != 4 {
+                    // A star point without extra grips is a plain vertex.
+                    let extents = &f.args[3..];
+                    if (3..=MAX_STAR_VALENCE).contains(&valence)
+                        && extents.len() == valence as usize
+                        && extents.iter().all(|x| *x == "0")
+                    {
+                        self.pend(line, "its vertex", vertex, Kind::Vertex);
+                        return Ok(());
+                    }
                     return Err(Error::Unsupported(format!(
-                        "tsm line {line}: a grip block of valence {valence} (an extraordinary point); only valence 4 is read"
+                        "tsm line {line}: a grip block of valence {valence} with extra grips (Bézier end conditions or creases at a star point); only star points without extra grips are read"
                     )));
                 }
                 if f.args.len() < 7 {
