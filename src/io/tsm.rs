@@ -27,7 +27,8 @@
 //!   N, W, S, E (counter-clockwise) a wedge listing the grips `a` steps along k and `b` steps
 //!   along the next direction, `a` in 1..=d_k then `b` in 0..=d_(k+1); -1 is a hole (the
 //!   outside quadrant of a concave corner). Blocks encode Bézier end conditions and creases.
-//!   A star point writes `0m cg V n 0 … 0` (valence n, no extra grips): a plain vertex.
+//!   A `cg` record of valence n other than 4 with all extents 0 (a star point without extra
+//!   grips; no public file has one to confirm the form) is read as a plain vertex.
 //! - `ec edge c`: an edge condition, `c` = 0 on boundary edges (kept in
 //!   [`TsmMeta::edge_conditions`]; creases themselves come from grip blocks).
 //! - `100001uv s t`: parameters of each vertex slot (kept for checking, see
