@@ -605,6 +605,30 @@ fn the_tool_always_comes_from_the_side_the_surface_faces() {
     assert!(below_horizontal > 0, "the bottom needs the tool from below");
 }
 
+/// Samples at most 0.3 mm apart on a tessellation within 0.01 mm of the surface: a cylinder
+/// of radius r can sink between them by 0.3² / 8r (0.011 mm for a 1 mm shank).
+fn dense_samples(m: &Model) -> Vec<Point3> {
+    let (chordal, spacing) = (0.01, 0.3);
+    let t = m.tessellate(chordal);
+    let vertex = |i: u32| {
+        let p = &t.positions[3 * i as usize..3 * i as usize + 3];
+        Point3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+    };
+    let mut samples = Vec::new();
+    for tri in t.indices.chunks(3) {
+        let (a, b, c) = (vertex(tri[0]), vertex(tri[1]), vertex(tri[2]));
+        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+        let n = (longest / spacing).ceil().max(1.0) as usize;
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                samples.push(a + (b - a) * u + (c - a) * v);
+            }
+        }
+    }
+    samples
+}
+
 /// Surface samples in a uniform grid of cubes, for "is any sample inside this cylinder".
 struct SampleGrid {
     cell: f64,
@@ -665,6 +689,21 @@ impl SampleGrid {
     }
 }
 
+/// Least clearance (mm, negative inside) between the surface samples and the shank above the
+/// flutes or the holder of a tool with ball centre `c` and axis `axis`; `reach` when farther.
+fn tool_clearance(grid: &SampleGrid, o: &PlanOptions, c: Point3, axis: Vector3, reach: f64) -> f64 {
+    let (f, ls, lh) = (o.flute_length(), o.shank_length_mm, o.holder_length_mm);
+    let shank =
+        grid.clearance_to_cylinder(&(c + axis * f), &(c + axis * ls), o.shank_radius(), reach);
+    let holder = grid.clearance_to_cylinder(
+        &(c + axis * ls),
+        &(c + axis * (ls + lh)),
+        o.holder_radius_mm,
+        reach,
+    );
+    shank.min(holder)
+}
+
 #[test]
 fn the_turning_tool_between_cut_points_stays_out_of_the_head() {
     // The planner checks the poses between neighbouring cut points (every 2° of turn) with
@@ -673,54 +712,15 @@ fn the_turning_tool_between_cut_points_stays_out_of_the_head() {
     // must not enter the part, except at turns the planner itself reports as blocked.
     let (m, opts) = coarse_head(120.0);
     let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
-    // Samples at most `spacing` apart on a tessellation within 0.01 mm of the surface: a
-    // cylinder of radius r can sink between them by spacing² / 8r (0.011 mm for the 1 mm
-    // shank), so deeper than `tol` it would be seen.
-    let (chordal, spacing) = (0.01, 0.3);
-    let t = m.tessellate(chordal);
-    let vertex = |i: u32| {
-        let p = &t.positions[3 * i as usize..3 * i as usize + 3];
-        Point3::new(p[0] as f64, p[1] as f64, p[2] as f64)
-    };
-    let mut samples = Vec::new();
-    for tri in t.indices.chunks(3) {
-        let (a, b, c) = (vertex(tri[0]), vertex(tri[1]), vertex(tri[2]));
-        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-        let n = (longest / spacing).ceil().max(1.0) as usize;
-        for i in 0..=n {
-            for j in 0..=n - i {
-                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-                samples.push(a + (b - a) * u + (c - a) * v);
-            }
-        }
-    }
+    let samples = dense_samples(&m);
     let grid = SampleGrid::new(&samples, 2.0);
     let tol = 0.02;
-    let (f, ls, lh) = (
-        opts.flute_length(),
-        opts.shank_length_mm,
-        opts.holder_length_mm,
-    );
     let step = 1f64.to_radians();
     let (mut turns, mut poses, mut hits) = (0, 0, 0);
     let reach = 1.0;
     let mut least = reach;
     let moves = &planned.toolpath.moves;
-    let clearance = |c: Point3, axis: Vector3| {
-        let shank = grid.clearance_to_cylinder(
-            &(c + axis * f),
-            &(c + axis * ls),
-            opts.shank_radius(),
-            reach,
-        );
-        let holder = grid.clearance_to_cylinder(
-            &(c + axis * ls),
-            &(c + axis * (ls + lh)),
-            opts.holder_radius_mm,
-            reach,
-        );
-        shank.min(holder)
-    };
+    let clearance = |c: Point3, axis: Vector3| tool_clearance(&grid, &opts, c, axis, reach);
     for (i, w) in moves.windows(2).enumerate() {
         let cutting = |k: MoveKind| matches!(k, MoveKind::Feed | MoveKind::Link);
         if !(w[0].kind.on_surface() && cutting(w[1].kind)) {
@@ -773,4 +773,43 @@ fn the_turning_tool_between_cut_points_stays_out_of_the_head() {
         "{hits} turns hit the part, the planner reports {} blocked",
         stats.sweep_hits
     );
+}
+
+#[test]
+fn air_moves_keep_shank_and_holder_out_of_the_head() {
+    // The air moves (approach, retract, escapes round the model) checked for the whole tool,
+    // not only the ball: every 0.5 mm along each, axis interpolated, against dense samples.
+    for start in [None, Some(1)] {
+        let (m, mut opts) = coarse_head(120.0);
+        opts.start_patch = start;
+        let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+        let grid = SampleGrid::new(&dense_samples(&m), 2.0);
+        let reach: f64 = 5.0;
+        let mut least = reach;
+        let mut checked = 0;
+        for w in planned.toolpath.moves.windows(2) {
+            let air = matches!(w[1].kind, MoveKind::Retract | MoveKind::Rapid)
+                || (w[1].kind == MoveKind::Plunge && w[0].kind == MoveKind::Rapid);
+            if !air {
+                continue;
+            }
+            checked += 1;
+            let n = ((w[1].cl_point - w[0].cl_point).norm() / 0.5)
+                .ceil()
+                .max(1.0) as usize;
+            for k in 0..=n {
+                let s = k as f64 / n as f64;
+                let c = w[0].cl_point + (w[1].cl_point - w[0].cl_point) * s;
+                let axis = (w[0].tool_axis * (1.0 - s) + w[1].tool_axis * s).normalize();
+                least = least.min(tool_clearance(&grid, &opts, c, axis, reach));
+            }
+        }
+        println!("head from patch {start:?}: {checked} air moves, least shank/holder clearance {least:.4} mm");
+        assert!(checked >= 2, "an approach and a retract at least");
+        assert!(
+            least > -0.02,
+            "from patch {start:?}: the shank or holder enters the head by {} mm on an air move",
+            -least
+        );
+    }
 }
