@@ -525,7 +525,7 @@ fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
     );
     assert!(
         planned.axes.sweep_hits * 10_000 < report.cl_points,
-        "{} turns put the shank or holder into the head",
+        "{} turns keep less than the planner's margin from the head",
         planned.axes.sweep_hits
     );
     assert_eq!(v.unreached_samples, 0, "the whole head is cut");

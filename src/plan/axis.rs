@@ -575,13 +575,20 @@ pub struct AxisStats {
     pub tilted: usize,
     /// Points where no axis within the allowed tilt is clear (three-axis: where +Z hits).
     pub blocked: usize,
+    /// Of the blocked points, those where the surface faces away from +Z (three-axis: the
+    /// tool would come from behind the surface).
+    pub facing_away: usize,
     /// The first of those, for the report.
     pub first_blocked: Option<Point3>,
     /// Moves between two cut points whose axis turn was split into smaller clear turns.
     pub bridged: usize,
     /// Moves between two cut points during which the turning tool's shank or holder
-    /// still passes through the model (poses checked every `SWEEP_STEP_DEG` of turn).
+    /// still comes within the safety margin of the model (poses checked every
+    /// `SWEEP_STEP_DEG` of turn).
     pub sweep_hits: usize,
+    /// That safety margin: the obstacle samples' gap (mm) by which shank and holder are
+    /// grown.
+    pub margin_mm: f64,
     /// The end of the first of those (ball centre, mm).
     pub first_sweep_hit: Option<Point3>,
     /// How the retracts and approaches were routed around the model.
@@ -772,6 +779,9 @@ pub fn assign(
                 }
                 None => {
                     stats.blocked += 1;
+                    if normal.z < MIN_AXIS_NORMAL_COS {
+                        stats.facing_away += 1;
+                    }
                     stats.first_blocked.get_or_insert(c);
                 }
             }
@@ -804,6 +814,7 @@ pub fn assign(
     for (m, a) in path.moves.iter_mut().zip(&axes) {
         m.tool_axis = *a;
     }
+    stats.margin_mm = obs.gap_mm();
     bridge_turns(path, &obs, opts, &mut stats);
     stats.air = super::air::route(model, path, opts, &obs);
     if stats.blocked > 0 && opts.max_tilt_deg > 0.0 {

@@ -388,9 +388,18 @@ impl Planned {
             ));
         }
         if let Some(p) = self.axes.first_blocked {
+            let (blocked, away) = (self.axes.blocked, self.axes.facing_away);
+            let why = match (away, blocked - away) {
+                (0, _) => "the shank or holder would hit the model".to_string(),
+                (_, 0) => "the surface faces away from +Z (the tool would come from behind it)"
+                    .to_string(),
+                (a, h) => format!(
+                    "at {a} the surface faces away from +Z (the tool would come from behind it), at {h} the shank or holder would hit the model"
+                ),
+            };
             r.notes.push(format!(
-                "with the tool axis at +Z the shank or holder would hit the model at {} points, the first at ball centre ({:.3}, {:.3}, {:.3}) mm: use a five-axis machine, a longer shank or a smaller holder",
-                self.axes.blocked, p.x, p.y, p.z
+                "with the tool axis at +Z {blocked} points cannot be cut, the first at ball centre ({:.3}, {:.3}, {:.3}) mm: {why}; use a five-axis machine, a longer shank or a smaller holder",
+                p.x, p.y, p.z
             ));
         }
         if self.axes.bridged > 0 {
@@ -401,8 +410,8 @@ impl Planned {
         }
         if let Some(p) = self.axes.first_sweep_hit {
             r.notes.push(format!(
-                "at {} moves the shank or holder passes through the model while the tool axis turns between two cut points, the first ending at ball centre ({:.3}, {:.3}, {:.3}) mm: allow more tilt, use a longer shank or a smaller holder",
-                self.axes.sweep_hits, p.x, p.y, p.z
+                "at {} moves the shank or holder comes within the {:.2} mm safety margin of the model (and may touch it) while the tool axis turns between two cut points, the first ending at ball centre ({:.3}, {:.3}, {:.3}) mm: allow more tilt, use a longer shank or a smaller holder",
+                self.axes.sweep_hits, self.axes.margin_mm, p.x, p.y, p.z
             ));
         }
         let air = &self.axes.air;
