@@ -104,3 +104,86 @@ fn machine_and_dialect_errors_are_actionable() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn rapids_turn_the_rotaries_only_at_the_top_of_z() {
+    // face.tsm with a fat short shank needs tilted axes and three retractions between
+    // patches whose axes differ. A rapid that turned the rotaries while traversing would
+    // swing the table (and the part) under the tool: they turn at the top of Z first.
+    let dir = std::env::temp_dir().join(format!("tspath-rapids-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("face.nc").to_str().unwrap().to_string();
+    run(&args(&[
+        "plan",
+        "../shared/fixtures/tsm/face.tsm",
+        "--tool-radius",
+        "1",
+        "--scallop",
+        "0.3",
+        "--max-tilt",
+        "90",
+        "--shank",
+        "2",
+        "--shank-length",
+        "6",
+        "--holder",
+        "10",
+        "--holder-length",
+        "30",
+        "--machine",
+        "table-table-ac",
+        "-o",
+        &out,
+    ]))
+    .unwrap();
+    let program = std::fs::read_to_string(&out).unwrap();
+    let word = |line: &str, c: char| {
+        line.split_whitespace()
+            .find(|w| w.starts_with(c))
+            .map(|w| w[1..].to_string())
+    };
+    let (mut rot, mut at_top, mut turned_at_top) = ((None, None), false, 0);
+    for line in program.lines() {
+        if line.starts_with("G53") {
+            at_top = true;
+            continue;
+        }
+        let (a, c) = (word(line, 'A'), word(line, 'C'));
+        if a.is_none() && c.is_none() {
+            continue;
+        }
+        let moves_xyz = ['X', 'Y', 'Z'].iter().any(|&k| word(line, k).is_some());
+        let turns = rot != (a.clone(), c.clone()) && rot != (None, None);
+        if line.starts_with("G0") && turns {
+            assert!(
+                at_top && !moves_xyz,
+                "a rapid turns the rotaries away from the top of Z: {line}"
+            );
+            turned_at_top += 1;
+        }
+        if moves_xyz {
+            at_top = false;
+        }
+        rot = (a, c);
+    }
+    println!("face.tsm, table-table-ac: the rotaries turn {turned_at_top} times at the top of Z");
+    assert!(
+        turned_at_top >= 2,
+        "the retractions between patches turn the rotaries"
+    );
+    // The program reads back and simulates.
+    let report = run(&args(&[
+        "verify",
+        "../shared/fixtures/tsm/face.tsm",
+        &out,
+        "--tool-radius",
+        "1",
+        "--machine",
+        "table-table-ac",
+        "--samples",
+        "20000",
+    ]))
+    .unwrap();
+    assert!(report.contains("max_scallop_mm"), "{report}");
+    std::fs::remove_dir_all(&dir).ok();
+}

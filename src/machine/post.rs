@@ -729,6 +729,22 @@ pub fn post_program(
                 }
             }
         }
+        // A rapid that turns the rotaries would sweep the tip along a curve, and on a
+        // table machine swing the part up towards the tool: turn them at the top of Z
+        // first, as at the start of the program.
+        if rapid && rot_moves && mode == OutputMode::Joints && last_tip.is_some() {
+            o.motion(&safe_top());
+            o.motion(&Motion {
+                rapid: true,
+                machine_frame: false,
+                xyz: [None; 3],
+                rotary: motion.rotary.clone(),
+                feed_mode: None,
+                feed: None,
+                extra: "",
+                source: Source::Safe,
+            });
+        }
         o.motion(&motion);
         last_rot_text = rot_text;
         last_tip = Some(e.tip);
