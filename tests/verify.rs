@@ -670,3 +670,43 @@ fn a_gouge_hidden_between_samples_is_within_the_bound() {
     );
     assert!(dip <= v.max_gouge_mm + v.gouge_error_bound_mm);
 }
+
+#[test]
+fn face_tsm_creases_are_cut_without_gouging() {
+    // face.tsm's grip blocks at the eyes' concave corners put C0 creases into the surface
+    // (up to 12.7°). A ball placed by one face's normal there cut 0.0305 mm into the other
+    // face (319 of 300 k samples beyond the chordal tolerance) until such CL points were
+    // lifted to touch both faces.
+    let bytes = std::fs::read("../shared/fixtures/tsm/face.tsm").unwrap();
+    let m = tspath::io::load(&bytes, "face").unwrap();
+    let (r, h) = (1.0, 0.3);
+    let opts = PlanOptions::default().with_tool_radius(r).with_scallop(h);
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+    let lifted = planned.gouge;
+    assert!(lifted.lifted > 0 && lifted.residual == 0, "{lifted:?}");
+    let v = verify::verify(
+        &m.surface,
+        &CutterPath::from_toolpath(&planned.toolpath).unwrap(),
+        &VerifyOptions::default()
+            .with_samples(300_000)
+            .with_scallop(h)
+            .with_gouge_tolerance(opts.chordal_mm),
+    )
+    .unwrap();
+    println!(
+        "face.tsm r={r} h={h}: {} CL points lifted (deepest cut {:.4} mm before); simulated max gouge {:.4} mm (bound {:.1e}), {} beyond chordal; max scallop {:.4} mm (bound {:.1e}), unreached {}",
+        lifted.lifted,
+        lifted.worst_mm,
+        v.max_gouge_mm,
+        v.gouge_error_bound_mm,
+        v.gouge_count,
+        v.max_scallop_mm,
+        v.scallop_error_bound_mm,
+        v.unreached_samples
+    );
+    assert!(lifted.worst_mm > 0.02, "the creases did cut in");
+    assert_eq!(v.gouge_count, 0);
+    assert!(v.max_gouge_mm <= opts.chordal_mm + v.gouge_error_bound_mm);
+    assert_eq!(v.unreached_samples, 0);
+    assert!(v.max_scallop_mm <= h + v.scallop_error_bound_mm);
+}

@@ -367,7 +367,13 @@ pub struct Planned {
     pub forced_retractions: usize,
     /// What the tool-axis assignment found.
     pub axes: axis::AxisStats,
+    /// CL points lifted where the ball cut into another face (a crease).
+    pub gouge: super::gouge::GougeStats,
 }
+
+/// Share of the chordal tolerance by which a ball may cut into the surface at a CL point
+/// before the point is lifted (the rest is left to the straight moves between points).
+const GOUGE_LIFT_SHARE: f64 = 0.2;
 
 impl Planned {
     /// The report of this plan, with notes on forced retractions and collisions.
@@ -379,6 +385,18 @@ impl Planned {
             r.notes.push(format!(
                 "no patch order and transit corners avoid retractions on this layout: {} retraction(s) used",
                 self.forced_retractions
+            ));
+        }
+        if let Some(p) = self.gouge.worst_at {
+            r.notes.push(format!(
+                "at {} points the ball, placed by its own face's normal, cut into a neighbouring face (a crease in the surface) by up to {:.4} mm, the deepest at ball centre ({:.3}, {:.3}, {:.3}) mm: they were lifted to touch both faces",
+                self.gouge.lifted, self.gouge.worst_mm, p.x, p.y, p.z
+            ));
+        }
+        if self.gouge.residual > 0 {
+            r.notes.push(format!(
+                "{} points stay up to {:.4} mm inside the surface after lifting",
+                self.gouge.residual, self.gouge.residual_mm
             ));
         }
         if self.axes.tilted > 0 {
@@ -702,11 +720,22 @@ pub fn plan(
         runs,
         params,
     };
+    let gouge = if super::gouge::may_crease(&model.mesh) {
+        super::gouge::lift(
+            &model.surface,
+            &mut toolpath,
+            r,
+            GOUGE_LIFT_SHARE * opts.chordal_mm,
+        )
+    } else {
+        super::gouge::GougeStats::default()
+    };
     let axes = axis::assign(model, &mut toolpath, opts, &mut |f| progress(0.8 + 0.2 * f))?;
     Ok(Planned {
         toolpath,
         forced_retractions: forced,
         axes,
+        gouge,
     })
 }
 

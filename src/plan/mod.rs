@@ -7,6 +7,7 @@
 pub mod air;
 pub mod axis;
 pub mod corners;
+pub mod gouge;
 pub mod isoparametric;
 pub mod options;
 pub mod order;
