@@ -1183,23 +1183,7 @@ fn fusion_exports_read_as_catmull_clark_cages() {
     assert!(distance_to_surface(&a.surface, &samples_of(&a.surface), corner) < 1e-9);
 
     // A closed box: eight star points (valence 3), read and tessellated.
-    let mut pts = Vec::new();
-    for i in 0..8 {
-        pts.push([
-            0.01 * (i >> 2 & 1) as f64,
-            0.01 * (i >> 1 & 1) as f64,
-            0.01 * (i & 1) as f64,
-        ]);
-    }
-    let v = |x: usize, y: usize, z: usize| 4 * x + 2 * y + z;
-    let quads = [
-        [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
-        [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
-        [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
-        [v(0, 1, 0), v(0, 1, 1), v(1, 1, 1), v(1, 1, 0)],
-        [v(0, 0, 0), v(0, 0, 1), v(0, 1, 1), v(0, 1, 0)],
-        [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
-    ];
+    let (pts, quads) = box_cage(0.01);
     let m = tspath::io::load(
         synthetic_tsm(Writer::Fusion, &pts, &quads).as_bytes(),
         "box",
@@ -1215,6 +1199,23 @@ fn fusion_exports_read_as_catmull_clark_cages() {
         assert!((bb.min[k] + bb.max[k] - 10.0).abs() < 1e-9, "{bb:?}");
         assert!(bb.min[k] > 0.0 && bb.max[k] < 10.0, "{bb:?}");
     }
+}
+
+/// A cube of side `side` (file units) from the origin: corners and outward quadrilaterals.
+fn box_cage(side: f64) -> (Vec<[f64; 3]>, [[usize; 4]; 6]) {
+    let pts = (0..8)
+        .map(|i: usize| [i >> 2 & 1, i >> 1 & 1, i & 1].map(|b| side * b as f64))
+        .collect();
+    let v = |x: usize, y: usize, z: usize| 4 * x + 2 * y + z;
+    let quads = [
+        [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
+        [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
+        [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
+        [v(0, 1, 0), v(0, 1, 1), v(1, 1, 1), v(1, 1, 0)],
+        [v(0, 0, 0), v(0, 0, 1), v(0, 1, 1), v(0, 1, 0)],
+        [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
+    ];
+    (pts, quads)
 }
 
 fn samples_of(s: &Surface) -> Vec<(usize, f64, f64, Point3)> {
@@ -1235,23 +1236,7 @@ fn star_points_of_t_splines_for_rhino_are_read() {
     // A closed box in T-Splines for Rhino's conventions: its eight corners are star points of
     // valence 3 (`0m cg V 3 0 0 0`). Read as a T-spline, every face touches a star point and
     // is evaluated by subdivision: the same surface as the box read as a Fusion cage.
-    let mut pts = Vec::new();
-    for i in 0..8 {
-        pts.push([
-            10.0 * (i >> 2 & 1) as f64,
-            10.0 * (i >> 1 & 1) as f64,
-            10.0 * (i & 1) as f64,
-        ]);
-    }
-    let v = |x: usize, y: usize, z: usize| 4 * x + 2 * y + z;
-    let quads = [
-        [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
-        [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
-        [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
-        [v(0, 1, 0), v(0, 1, 1), v(1, 1, 1), v(1, 1, 0)],
-        [v(0, 0, 0), v(0, 0, 1), v(0, 1, 1), v(0, 1, 0)],
-        [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
-    ];
+    let (pts, quads) = box_cage(10.0);
     let text = synthetic_tsm(Writer::Rhino, &pts, &quads);
     assert_eq!(text.matches("0m cg").count(), 8);
     let (mesh, meta) = tsm::read(text.as_bytes()).unwrap();
