@@ -10,6 +10,7 @@
 //! come within the ball (thin walls) is not checked here.
 
 use super::{MoveKind, Toolpath};
+use crate::error::{Error, Result};
 use crate::geom::{Aabb, Point3};
 use crate::surface::Surface;
 use crate::tmesh::{Scheme, TMesh};
@@ -35,6 +36,8 @@ const START_SAMPLES: usize = 6;
 const NEWTON_STEPS: usize = 30;
 /// Lifting rounds per CL point (each moves it away from the then nearest point).
 const LIFT_ROUNDS: usize = 8;
+/// Moves between two checks for cancellation.
+const CANCEL_EVERY: usize = 256;
 
 /// Nearest-point queries against the surface: per face its box (from the Bézier control
 /// points, which contain it) and a few samples to start Newton from.
@@ -134,10 +137,20 @@ pub fn may_crease(mesh: &TMesh) -> bool {
 /// Lifts every cutting CL point of `path` whose ball of radius `r` cuts into the surface by
 /// more than `tol` mm, until it is a radius from the nearest surface point (within `tol`).
 /// The contact point becomes that nearest point.
-pub fn lift(surface: &Surface, path: &mut Toolpath, r: f64, tol: f64) -> GougeStats {
+/// `keep_going` is asked every few hundred moves; false cancels.
+pub fn lift(
+    surface: &Surface,
+    path: &mut Toolpath,
+    r: f64,
+    tol: f64,
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Result<GougeStats> {
     let near = Nearest::new(surface);
     let mut stats = GougeStats::default();
-    for m in path.moves.iter_mut() {
+    for (i, m) in path.moves.iter_mut().enumerate() {
+        if i % CANCEL_EVERY == 0 && !keep_going() {
+            return Err(Error::Cancelled);
+        }
         if !matches!(m.kind, MoveKind::Feed | MoveKind::Link) {
             continue;
         }
@@ -173,5 +186,5 @@ pub fn lift(surface: &Surface, path: &mut Toolpath, r: f64, tol: f64) -> GougeSt
         m.cl_point = c;
         m.cc_point = contact;
     }
-    stats
+    Ok(stats)
 }

@@ -726,7 +726,8 @@ pub fn plan(
             &mut toolpath,
             r,
             GOUGE_LIFT_SHARE * opts.chordal_mm,
-        )
+            &mut || progress(0.8),
+        )?
     } else {
         super::gouge::GougeStats::default()
     };

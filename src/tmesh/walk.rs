@@ -3,8 +3,9 @@
 //! A ray leaves a vertex in one of its four directions and crosses knot lines: along an edge
 //! it reaches the edge's far vertex; inside a face it crosses to the opposite side. Each
 //! crossing is one bay, except a crossing of a fan line between its ends (a repeated knot
-//! that exists only at the grip block it leaves, see [`super`]). Two bays in each direction give the five knots of a cubic blending
-//! function; where the ray leaves the mesh the last knot repeats.
+//! that exists only at the grip block it leaves, see [`super`]). Two bays in each direction
+//! give the five knots of a cubic blending function; where the ray leaves the mesh the last
+//! knot repeats.
 //!
 //! Everything is topological (sides of faces, quarter turns around vertices) so that zero
 //! knot intervals, which encode repeated knots, walk like any others.
