@@ -392,28 +392,27 @@ fn clearance(samples: &[Point3], c: &Point3, axis: &Vector3, o: &PlanOptions) ->
     let (f, ls, lh) = (o.flute_length(), o.shank_length_mm, o.holder_length_mm);
     let mut best = f64::INFINITY;
     for p in samples {
-        let d = p - c;
-        let a = d.dot(axis);
-        let radial = (d - axis * a).norm();
         for (a0, a1, rad) in [(f, ls, o.shank_radius()), (ls, ls + lh, o.holder_radius_mm)] {
-            // Distance from the point to the solid cylinder.
-            let out_axial = if a < a0 {
-                a0 - a
-            } else if a > a1 {
-                a - a1
-            } else {
-                0.0
-            };
-            let out_radial = (radial - rad).max(0.0);
-            let dist = if out_axial == 0.0 && out_radial == 0.0 {
-                -(rad - radial).min(a - a0).min(a1 - a)
-            } else {
-                out_axial.hypot(out_radial)
-            };
+            let dist = cylinder_distance(p, &(c + axis * a0), axis, a1 - a0, rad);
             best = best.min(dist);
         }
     }
     best
+}
+
+/// Signed distance (mm, negative inside) from `p` to the solid cylinder of radius `rad`
+/// whose axis runs from `a` along the unit vector `dir` for `len`.
+fn cylinder_distance(p: &Point3, a: &Point3, dir: &Vector3, len: f64, rad: f64) -> f64 {
+    let d = p - a;
+    let t = d.dot(dir);
+    let radial = (d - dir * t).norm();
+    let out_axial = (-t).max(t - len).max(0.0);
+    let out_radial = (radial - rad).max(0.0);
+    if out_axial == 0.0 && out_radial == 0.0 {
+        -(rad - radial).min(t).min(len - t)
+    } else {
+        out_axial.hypot(out_radial)
+    }
 }
 
 #[test]
@@ -670,17 +669,7 @@ impl SampleGrid {
                         continue;
                     };
                     for p in ps {
-                        let d = p - a;
-                        let t = d.dot(&dir);
-                        let radial = (d - dir * t).norm();
-                        let out_axial = (-t).max(t - len).max(0.0);
-                        let out_radial = (radial - rad).max(0.0);
-                        let dist = if out_axial == 0.0 && out_radial == 0.0 {
-                            -(rad - radial).min(t).min(len - t)
-                        } else {
-                            out_axial.hypot(out_radial)
-                        };
-                        least = least.min(dist);
+                        least = least.min(cylinder_distance(p, a, &dir, len, rad));
                     }
                 }
             }

@@ -34,6 +34,8 @@ pub struct GougeStats {
 const START_SAMPLES: usize = 6;
 /// Newton steps of the nearest-point search on one face.
 const NEWTON_STEPS: usize = 30;
+/// Parameter step (of a face's unit square) below which the search has converged.
+const NEWTON_CONVERGED: f64 = 1e-12;
 /// Lifting rounds per CL point (each moves it away from the then nearest point).
 const LIFT_ROUNDS: usize = 8;
 /// Moves between two checks for cancellation.
@@ -112,7 +114,7 @@ impl<'a> Nearest<'a> {
                 );
                 let moved = (nu - u).abs().max((nv - v).abs());
                 (u, v) = (nu, nv);
-                if moved < 1e-12 {
+                if moved < NEWTON_CONVERGED {
                     break;
                 }
             }
@@ -154,7 +156,7 @@ pub fn lift(
         if !matches!(m.kind, MoveKind::Feed | MoveKind::Link) {
             continue;
         }
-        let Some((d, _)) = near.nearest(&m.cl_point, r) else {
+        let Some((d, q)) = near.nearest(&m.cl_point, r) else {
             continue;
         };
         if d >= r - tol {
@@ -165,20 +167,21 @@ pub fn lift(
             stats.worst_at = Some(m.cl_point);
         }
         stats.lifted += 1;
-        let mut c = m.cl_point;
-        let mut contact = m.cc_point;
+        let (mut c, mut nearest) = (m.cl_point, (d, q));
         let mut depth = r - d;
-        for round in 0..=LIFT_ROUNDS {
-            let Some((d, q)) = near.nearest(&c, r) else {
+        for round in 0..LIFT_ROUNDS {
+            let (d, q) = nearest;
+            c += (c - q) / d * depth;
+            let Some(next) = near.nearest(&c, r) else {
                 break;
             };
-            depth = r - d;
-            contact = q;
-            if depth <= 0.1 * tol || round == LIFT_ROUNDS {
+            nearest = next;
+            depth = r - next.0;
+            if depth <= 0.1 * tol || round + 1 == LIFT_ROUNDS {
                 break;
             }
-            c += (c - q) / d * depth;
         }
+        let contact = nearest.1;
         if depth > tol {
             stats.residual += 1;
             stats.residual_mm = stats.residual_mm.max(depth);
