@@ -5,7 +5,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 
 fn load_face(c: &mut Criterion) {
-    let path = "../shared/fixtures/tsm/face.tsm";
+    let path = "www/models/grapetec/face.tsm";
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
     c.bench_function("tsm/face.tsm load to evaluable surface", |b| {
         b.iter(|| tspath::io::load(black_box(&bytes), "face").expect("face.tsm loads"))

@@ -115,7 +115,7 @@ fn rapids_turn_the_rotaries_only_at_the_top_of_z() {
     let out = dir.join("face.nc").to_str().unwrap().to_string();
     run(&args(&[
         "plan",
-        "../shared/fixtures/tsm/face.tsm",
+        "www/models/grapetec/face.tsm",
         "--tool-radius",
         "1",
         "--scallop",
@@ -174,7 +174,7 @@ fn rapids_turn_the_rotaries_only_at_the_top_of_z() {
     // The program reads back and simulates.
     let report = run(&args(&[
         "verify",
-        "../shared/fixtures/tsm/face.tsm",
+        "www/models/grapetec/face.tsm",
         &out,
         "--tool-radius",
         "1",

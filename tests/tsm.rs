@@ -1,4 +1,4 @@
-//! The .tsm reader on the real T-Splines files in `../shared/fixtures/tsm/` (read in place),
+//! The .tsm reader on the real T-Splines files in `www/models/grapetec/` (GrapeTec/T-SPLINE, LGPL-3.0),
 //! checked against what must hold of any T-spline read right: shared face boundaries agree
 //! from both sides, parameters agree with the file's own `100001uv` records, Bézier end
 //! conditions interpolate the boundary corners, the surface stays in the convex hull of each
@@ -24,7 +24,7 @@ const EXTRA_DIR_VAR: &str = "TSPATH_EXTRA_TSM_DIR";
 fn model_paths() -> Vec<String> {
     let mut out: Vec<String> = FIXTURES
         .iter()
-        .map(|n| format!("../shared/fixtures/tsm/{n}.tsm"))
+        .map(|n| format!("www/models/grapetec/{n}.tsm"))
         .collect();
     if let Ok(dir) = std::env::var(EXTRA_DIR_VAR) {
         let mut extra: Vec<String> = std::fs::read_dir(&dir)
@@ -45,7 +45,7 @@ fn read_path(path: &str) -> Vec<u8> {
 }
 
 fn fixture_bytes(name: &str) -> Vec<u8> {
-    read_path(&format!("../shared/fixtures/tsm/{name}.tsm"))
+    read_path(&format!("www/models/grapetec/{name}.tsm"))
 }
 
 struct Loaded {
@@ -535,7 +535,7 @@ fn surface_agrees_with_an_independent_reader() {
     // corners, edge midpoints and centre of each of its faces (concave boundary corners
     // included), must lie on our surface.
     for name in FIXTURES {
-        let l = load(&format!("../shared/fixtures/tsm/{name}.tsm"));
+        let l = load(&format!("www/models/grapetec/{name}.tsm"));
         let n = 16;
         let mut samples = Vec::new();
         for f in 0..l.surface.faces().len() {

@@ -677,7 +677,7 @@ fn face_tsm_creases_are_cut_without_gouging() {
     // (up to 12.7°). A ball placed by one face's normal there cut 0.0305 mm into the other
     // face (319 of 300 k samples beyond the chordal tolerance) until such CL points were
     // lifted to touch both faces.
-    let bytes = std::fs::read("../shared/fixtures/tsm/face.tsm").unwrap();
+    let bytes = std::fs::read("www/models/grapetec/face.tsm").unwrap();
     let m = tspath::io::load(&bytes, "face").unwrap();
     let (r, h) = (1.0, 0.3);
     let opts = PlanOptions::default().with_tool_radius(r).with_scallop(h);

@@ -129,7 +129,7 @@ fn machine_dialect_and_units_choice() {
 #[wasm_bindgen_test]
 fn tsm_bytes_load_through_the_same_loader() {
     // A real T-Splines file, detected from its `#TS0200` tag.
-    let bytes = include_bytes!("../../shared/fixtures/tsm/simple.tsm");
+    let bytes = include_bytes!("../www/models/grapetec/simple.tsm");
     let model = Model::from_bytes(bytes, "simple").unwrap();
     let summary = model.summary().unwrap();
     assert_eq!(get(&summary, "format").as_string().as_deref(), Some("tsm"));
