@@ -18,6 +18,8 @@ const USAGE: &str = "usage:
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [-o OUT.nc] [--report REPORT.json] [--verify [--verify-samples N]]
+              exits with 3 after writing its outputs when the plan has problems (rest area,
+              gouges, scallop over the request, an unproven simulation), listed on stderr
   tspath machine --list
   tspath machine NAME [-o FILE.json]
   tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
@@ -31,22 +33,45 @@ tspath-cl JSON tool path and prints the scallops and gouges it leaves as JSON; -
 raises the sample count until the stated error bound is within MM.
 ";
 
+/// What a command did, beyond its output.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Status {
+    /// Done as asked.
+    Done,
+    /// `plan` wrote its outputs, but the plan leaves something undone: these problems
+    /// (one line each). The command exits with [`EXIT_PROBLEMS`].
+    Problems(Vec<String>),
+}
+
+/// Exit status of `tspath plan` when the plan has problems (rest area, gouges, scallop over
+/// the request, turns within the safety margin, an unproven simulation), after writing its
+/// outputs. Errors exit with 2.
+pub const EXIT_PROBLEMS: u8 = 3;
+
 /// Runs one command; returns what it prints on success.
 pub fn run(args: &[String]) -> Result<String> {
+    run_with_status(args).map(|(out, _)| out)
+}
+
+/// Runs one command; returns what it prints on success and whether a plan has problems.
+pub fn run_with_status(args: &[String]) -> Result<(String, Status)> {
     let Some(cmd) = args.first() else {
         return Err(Error::Io(USAGE.into()));
     };
     let rest = &args[1..];
-    match cmd.as_str() {
+    if cmd == "plan" {
+        return plan(rest);
+    }
+    let out = match cmd.as_str() {
         "info" => info(rest),
         "sample" => sample(rest),
-        "plan" => plan(rest),
         "verify" => verify_cmd(rest),
         "export" => export(rest),
         "machine" => machine_cmd(rest),
         "-h" | "--help" | "help" => Ok(USAGE.into()),
         other => Err(Error::Io(format!("unknown command `{other}`\n{USAGE}"))),
-    }
+    }?;
+    Ok((out, Status::Done))
 }
 
 /// Loads a model file, or a built-in sample when no file of that name exists.
@@ -202,7 +227,7 @@ fn export(args: &[String]) -> Result<String> {
     ))
 }
 
-fn plan(args: &[String]) -> Result<String> {
+fn plan(args: &[String]) -> Result<(String, Status)> {
     let a = parse(
         args,
         &[
@@ -292,27 +317,41 @@ fn plan(args: &[String]) -> Result<String> {
     let planned = isoparametric::plan(&m, &opts, &mut |_| true)?;
     let mut report = planned.report(&opts);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let rest = planned.rest_rects(&m);
     let path = planned.toolpath;
     let gcode = machine::post(
         &path,
         &opts,
         &JobInfo {
             model: m.name.clone(),
-            strategy: "isoparametric".into(),
+            strategy: planned.strategy.into(),
         },
         &mach,
         dialect,
         units,
     )?;
-    let mut report_value = serde_json::to_value(&report).expect("report serialises");
-    if a.has("--verify") {
+    let verification = if a.has("--verify") {
         let mut vopts = VerifyOptions::default()
             .with_scallop(opts.scallop_mm)
-            .with_gouge_tolerance(opts.chordal_mm);
+            .with_gouge_tolerance(verify::gouge_tolerance_for(opts.chordal_mm))
+            .with_rest_area(rest);
         if let Some(n) = a.count("--verify-samples")? {
             vopts = vopts.with_samples(n);
         }
-        let v = verify::verify(&m.surface, &CutterPath::from_toolpath(&path)?, &vopts)?;
+        // Enough samples for the bound to prove the scallop: a quarter of it.
+        let v = verify::verify_to_bound(
+            &m.surface,
+            &CutterPath::from_toolpath(&path)?,
+            &vopts,
+            VERIFY_BOUND_SHARE * opts.scallop_mm,
+        )?;
+        report.add_verification(&v);
+        Some(v)
+    } else {
+        None
+    };
+    let mut report_value = serde_json::to_value(&report).expect("report serialises");
+    if let Some(v) = verification {
         report_value["verify"] = serde_json::to_value(&v).expect("verification serialises");
     }
     let report_json =
@@ -327,8 +366,17 @@ fn plan(args: &[String]) -> Result<String> {
         None if a.value("-o").is_some() => out.push_str(&report_json),
         None => {}
     }
-    Ok(out)
+    let status = if report.problems.is_empty() {
+        Status::Done
+    } else {
+        Status::Problems(report.problems.iter().map(|p| p.message.clone()).collect())
+    };
+    Ok((out, status))
 }
+
+/// The error bound a plan's verification aims for, as a share of the scallop height: a
+/// bound well below the scallop is what makes the measurement prove it.
+pub const VERIFY_BOUND_SHARE: f64 = 0.25;
 
 fn verify_cmd(args: &[String]) -> Result<String> {
     let a = parse(

@@ -38,6 +38,7 @@ fn check_structure(name: &str, model: &Model, path: &Toolpath, opts: &PlanOption
             index: run.patch as usize,
             patch: &model.layout.patches[run.patch as usize],
             surface: &model.surface,
+            side: model.tool_side(),
         };
         let corner = |c: u8| {
             let (u, v) = corner_uv(c);
@@ -107,9 +108,10 @@ fn keycaps_at_the_papers_settings_need_no_retraction() {
 }
 
 #[test]
-fn head_and_t_junction_sample_need_no_retraction() {
-    // The closed head is planned three-axis: its underside cannot be reached from above,
-    // which the report says; the path itself is still one piece.
+fn t_junction_sample_needs_no_retraction_and_the_three_axis_head_leaves_its_underside() {
+    // The closed head planned three-axis: its underside cannot be reached from above. The
+    // plan leaves it out, says so as a problem with the area and why, and the path cuts
+    // only what a vertical tool reaches (issue 13).
     let mut opts = PlanOptions::default()
         .with_tool_radius(2.0)
         .with_scallop(0.05)
@@ -117,22 +119,53 @@ fn head_and_t_junction_sample_need_no_retraction() {
     opts.max_tilt_deg = 0.0;
     let head = samples::load_sample("head").unwrap();
     let planned = isoparametric::plan(&head, &opts, &mut |_| true).unwrap();
-    check_structure("head", &head, &planned.toolpath, &opts);
     assert!(
         planned.axes.blocked > 0,
         "the holder hits the head from below"
     );
-    assert!(planned
-        .report(&opts)
-        .notes
-        .iter()
-        .any(|n| n.contains("would hit")));
+    let report = planned.report(&opts);
+    assert_eq!(report.status, tspath::plan::PlanStatus::PlannedWithProblems);
+    let area = |kind: &str| -> f64 {
+        report
+            .rest
+            .iter()
+            .filter(|g| {
+                format!(
+                    "rest_{}",
+                    serde_json::to_value(g.why).unwrap().as_str().unwrap()
+                ) == kind
+            })
+            .map(|g| g.area_mm2)
+            .sum()
+    };
+    let (away, hits) = (area("rest_faces_away"), area("rest_tool_hits"));
+    println!(
+        "head three-axis: {} CL points, rest {:.0} mm² (faces away {away:.0}, tool hits {hits:.0}) in {} regions, {} retractions",
+        report.cl_points,
+        report.unreachable_area_mm2,
+        report.rest.len(),
+        report.retractions
+    );
+    assert!(report.problems.iter().any(|p| p.kind == "rest_faces_away"));
+    assert!(away > 1000.0 && hits > 0.0);
+    assert!((away + hits - report.unreachable_area_mm2).abs() < 1e-6 * report.unreachable_area_mm2);
+    // Every cut point kept has a usable vertical tool: its surface faces up.
+    for m in &planned.toolpath.moves {
+        if m.kind.on_surface() {
+            let n = (m.cl_point - m.cc_point).normalize();
+            assert!(n.z > 0.0, "a cut point facing down is still cut: {n}");
+        }
+    }
     let t = samples::load_sample("tjunction").unwrap();
     let opts = PlanOptions::default()
         .with_tool_radius(1.0)
         .with_scallop(0.01);
     let planned = isoparametric::plan(&t, &opts, &mut |_| true).unwrap();
     check_structure("tjunction", &t, &planned.toolpath, &opts);
+    assert_eq!(
+        planned.report(&opts).status,
+        tspath::plan::PlanStatus::Planned
+    );
 }
 
 fn brute_force(m: &CostMatrix, start: usize, finish: Option<usize>) -> f64 {
@@ -530,13 +563,24 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
     opts.start_patch = Some(1);
     let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
     let path = &planned.toolpath;
-    let air = planned.axes.air;
+    let air = planned.air;
     assert_eq!(air.blocked, 0);
-    let kinds: Vec<MoveKind> = path.moves.iter().take(3).map(|m| m.kind).collect();
-    assert_eq!(
-        kinds,
-        [MoveKind::Rapid, MoveKind::Rapid, MoveKind::Plunge],
-        "the approach comes down beside the head and plunges from there"
+    // Rapids down beside the head (and in under it), then the plunge onto the cut.
+    let plunge = path
+        .moves
+        .iter()
+        .position(|m| m.kind == MoveKind::Plunge)
+        .unwrap();
+    assert!(
+        plunge >= 2
+            && path.moves[..plunge]
+                .iter()
+                .all(|m| m.kind == MoveKind::Rapid),
+        "the approach comes down beside the head and plunges from there: {:?}",
+        path.moves[..=plunge]
+            .iter()
+            .map(|m| m.kind)
+            .collect::<Vec<_>>()
     );
     assert!(air.escaped >= 1);
     let t = m.tessellate(0.01);
@@ -574,15 +618,25 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
 fn the_tool_always_comes_from_the_side_the_surface_faces() {
     // The head's flat bottom faces straight down: no axis within 90° of +Z comes from below
     // it (a vertical tool there would run up through the part, its shank inside the head
-    // where no surface sample can see it), so planning within 90° must fail and say where.
+    // where no surface sample can see it), so planning within 90° leaves it out and says
+    // where and why.
     let (m, mut opts) = coarse_head(90.0);
-    let err = isoparametric::plan(&m, &opts, &mut |_| true)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("within 90° of +Z") && err.contains("allow more tilt"),
-        "{err}"
-    );
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+    let report = planned.report(&opts);
+    let away = report
+        .problems
+        .iter()
+        .find(|p| p.kind == "rest_faces_away")
+        .expect("the bottom is reported");
+    assert!(away.message.contains("allow more tilt"), "{}", away.message);
+    let err = away.message.clone();
+    // No cut point left faces down.
+    assert!(planned
+        .toolpath
+        .moves
+        .iter()
+        .filter(|m| m.kind.on_surface())
+        .all(|m| m.tool_axis.dot(&(m.cl_point - m.cc_point)) > 0.0));
     // A table tilting past upright presents the bottom: then every cut point's axis lies
     // on the side of its contact normal (from the contact to the ball centre).
     opts.max_tilt_deg = 120.0;

@@ -477,7 +477,7 @@ fn head_planned_five_axis_keeps_its_scallop_and_does_not_gouge() {
     let mut opts = PlanOptions::default().with_tool_radius(r).with_scallop(h);
     opts.max_tilt_deg = 120.0;
     let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
-    let air = planned.axes.air;
+    let air = planned.air;
     assert_eq!(air.blocked, 0, "every retract and approach finds a way out");
     assert!(
         air.escaped >= 1,

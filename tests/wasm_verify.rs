@@ -40,9 +40,10 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     ] {
         assert!(get(&s, key).as_f64().is_some(), "summary.{key}");
     }
-    // Defaults from the plan: its scallop and chordal tolerance.
+    // Defaults from the plan: its scallop, and its chordal tolerance or 0.002 mm, whichever
+    // is smaller.
     assert_eq!(get(&s, "requested_scallop_mm").as_f64(), Some(0.05));
-    assert_eq!(get(&s, "gouge_tolerance_mm").as_f64(), Some(0.005));
+    assert_eq!(get(&s, "gouge_tolerance_mm").as_f64(), Some(0.002));
     let max = get(&s, "max_scallop_mm").as_f64().unwrap();
     assert!(max > 0.03 && max < 0.07, "max scallop {max}");
     let heat = v.heat_map();
@@ -69,6 +70,19 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
         .unwrap();
     assert!((gmax - max).abs() < 1e-4, "{gmax} vs {max}");
     assert_eq!(g.heat_map().length(), heat.length());
+
+    // With `bound_mm` the samples grow until the error bound is within it, and the plan's
+    // report takes in what the simulation found.
+    let bounded = js_sys::Object::new();
+    js_sys::Reflect::set(&bounded, &"samples".into(), &20_000.into()).unwrap();
+    js_sys::Reflect::set(&bounded, &"bound_mm".into(), &0.0125.into()).unwrap();
+    let b = model.verify(&plan, &mesh, bounded.into()).unwrap();
+    let bs = b.summary().unwrap();
+    assert!(get(&bs, "error_bound_mm").as_f64().unwrap() <= 0.0125);
+    assert!(get(&bs, "samples").as_f64().unwrap() > 20_000.0);
+    assert_eq!(get(&bs, "error_bound_target_mm").as_f64(), Some(0.0125));
+    let report = plan.report_with(&b).unwrap();
+    assert_eq!(get(&report, "status").as_string().as_deref(), Some("planned"));
 
     let bad = js_sys::Object::new();
     js_sys::Reflect::set(&bad, &"samples".into(), &2.into()).unwrap();

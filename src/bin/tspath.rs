@@ -6,10 +6,18 @@ use std::process::ExitCode;
 #[cfg(not(target_arch = "wasm32"))]
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    match tspath::cli::run(&args) {
-        Ok(out) => {
+    match tspath::cli::run_with_status(&args) {
+        Ok((out, tspath::cli::Status::Done)) => {
             print!("{out}");
             ExitCode::SUCCESS
+        }
+        Ok((out, tspath::cli::Status::Problems(problems))) => {
+            print!("{out}");
+            eprintln!("tspath: planned with problems:");
+            for p in problems {
+                eprintln!("  - {p}");
+            }
+            ExitCode::from(tspath::cli::EXIT_PROBLEMS)
         }
         Err(e) => {
             eprintln!("tspath: {e}");

@@ -640,6 +640,46 @@ impl Patch {
         face.normal(x / face.width, y / face.height)
     }
 
+    /// The face rectangles a patch rectangle `[u0, u1, v0, v1]` covers: for each piece it
+    /// meets, the face and the part of the rectangle in that face's parameters `[a0, a1, b0,
+    /// b1]` (within `[0, 1]`). Pieces are placed by quarter turns, so the parts are
+    /// rectangles too.
+    pub fn face_rects(&self, surface: &Surface, rect: [f64; 4]) -> Vec<(u32, [f64; 4])> {
+        let lo = [rect[0] * self.width, rect[2] * self.height];
+        let hi = [rect[1] * self.width, rect[3] * self.height];
+        let mut out = Vec::new();
+        for p in &self.pieces {
+            let (a, b) = chart_rect(&p.local, (p.quarter_turns, p.offset));
+            let (clo, chi) = (
+                [lo[0].max(a[0]), lo[1].max(a[1])],
+                [hi[0].min(b[0]), hi[1].min(b[1])],
+            );
+            if clo[0] > chi[0] || clo[1] > chi[1] {
+                continue;
+            }
+            // Back to the face's knot coordinates, then to its unit square.
+            let back = |c: [f64; 2]| {
+                rot(
+                    (4 - p.quarter_turns) % 4,
+                    [c[0] - p.offset[0], c[1] - p.offset[1]],
+                )
+            };
+            let (x, y) = (back(clo), back(chi));
+            let face = &surface.faces()[p.face as usize];
+            let unit = |v: f64, size: f64| (v / size).clamp(0.0, 1.0);
+            out.push((
+                p.face,
+                [
+                    unit(x[0].min(y[0]), face.width),
+                    unit(x[0].max(y[0]), face.width),
+                    unit(x[1].min(y[1]), face.height),
+                    unit(x[1].max(y[1]), face.height),
+                ],
+            ));
+        }
+        out
+    }
+
     /// Point at patch parameters `(u, v)`.
     pub fn subs(&self, surface: &Surface, u: f64, v: f64) -> Point3 {
         let (p, [x, y]) = self.locate(u * self.width, v * self.height);

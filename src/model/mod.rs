@@ -23,7 +23,29 @@ pub struct Model {
     pub mesh: TMesh,
     pub surface: Surface,
     pub layout: PatchLayout,
+    /// The smallest concave radius, found once when first asked for.
+    concave: std::sync::OnceLock<Option<ConcaveSpot>>,
+    /// The side the tool works from, found once when first asked for.
+    side: std::sync::OnceLock<f64>,
 }
+
+/// Where the surface is most tightly concave towards the tool (on the side
+/// [`Model::tool_side`] says).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ConcaveSpot {
+    /// The smallest concave radius of curvature found (mm): the largest ball-end radius
+    /// that fits everywhere the surface is smooth.
+    pub radius_mm: f64,
+    /// Where (mm).
+    pub at_mm: [f64; 3],
+}
+
+/// Samples per face side deciding the side the tool works from.
+const SIDE_SAMPLES: usize = 4;
+
+/// Samples per face side for the smallest concave radius, evenly, plus the same again
+/// crowded towards the sides (curvature peaks at folded corners within 1% of a face).
+const CONCAVE_SAMPLES: usize = 9;
 
 /// Counts and size of a model, as shown by `tspath info` and the page.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -39,6 +61,9 @@ pub struct ModelSummary {
     pub holes: usize,
     pub patches: usize,
     pub bbox_mm: Aabb,
+    /// The smallest concave radius (mm) and where: the largest ball that reaches everywhere
+    /// the surface is smooth. `None` where nothing is concave.
+    pub smallest_concave_radius: Option<ConcaveSpot>,
 }
 
 impl Model {
@@ -53,6 +78,81 @@ impl Model {
             units_read: units_read.to_string(),
             mesh,
             surface,
+            concave: std::sync::OnceLock::new(),
+            side: std::sync::OnceLock::new(),
+        })
+    }
+
+    /// The side of the surface a tool machines: +1 where the normal `S_u × S_v` points to,
+    /// −1 for the other. A closed surface is machined from outside (the side its normal
+    /// points to when the enclosed volume comes out positive); an open one from the side
+    /// that faces up on the whole (the area-weighted mean of the normal's z), as a part
+    /// lies on the table. Found once, then remembered.
+    pub fn tool_side(&self) -> f64 {
+        *self.side.get_or_init(|| {
+            let n = SIDE_SAMPLES;
+            let (mut volume, mut up) = (0.0, 0.0);
+            for face in self.surface.faces() {
+                for i in 0..n {
+                    for j in 0..n {
+                        let (u, v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+                        let d = face.derivs(u, v);
+                        let a = d.su.cross(&d.sv);
+                        volume += d.point.coords.dot(&a);
+                        up += a.z;
+                    }
+                }
+            }
+            let closed = self.mesh.boundary_loops() == 0;
+            let s = if closed { volume } else { up };
+            if s < 0.0 {
+                -1.0
+            } else {
+                1.0
+            }
+        })
+    }
+
+    /// The smallest concave radius of the surface, sampled on every face (evenly and
+    /// densely near its sides); `None` where nothing is concave. C0 creases are not
+    /// curvature and are not seen here. Found once, then remembered.
+    pub fn smallest_concave_radius(&self) -> Option<ConcaveSpot> {
+        *self.concave.get_or_init(|| {
+            let n = CONCAVE_SAMPLES;
+            let even = (0..n).map(|k| k as f64 / (n - 1) as f64);
+            let crowded = (1..n).flat_map(|k| {
+                let e = 0.1f64.powi(k as i32);
+                [e, 1.0 - e]
+            });
+            let ts: Vec<f64> = even.chain(crowded).collect();
+            let mut best: Option<ConcaveSpot> = None;
+            for face in self.surface.faces() {
+                for &u in &ts {
+                    for &v in &ts {
+                        let d = face.derivs(u, v);
+                        let Some(g) = crate::surface::DiffGeom::try_from_derivs(&d) else {
+                            continue;
+                        };
+                        let g = if self.tool_side() < 0.0 {
+                            g.flipped()
+                        } else {
+                            g
+                        };
+                        let (_, k_hi) = g.principal();
+                        if !(k_hi > 0.0 && k_hi.is_finite()) {
+                            continue;
+                        }
+                        let radius = 1.0 / k_hi;
+                        if best.is_none_or(|b| radius < b.radius_mm) {
+                            best = Some(ConcaveSpot {
+                                radius_mm: radius,
+                                at_mm: [d.point.x, d.point.y, d.point.z],
+                            });
+                        }
+                    }
+                }
+            }
+            best
         })
     }
 
@@ -107,6 +207,7 @@ impl Model {
             holes: self.mesh.boundary_loops().saturating_sub(1),
             patches: self.layout.len(),
             bbox_mm: self.surface.bbox(),
+            smallest_concave_radius: self.smallest_concave_radius(),
         }
     }
 }

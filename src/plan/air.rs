@@ -4,13 +4,14 @@
 //! safe plane and the next cut point). Must not: change cutting moves or tool axes.
 //!
 //! The planner retracts straight up to the safe plane and comes straight down onto the next
-//! cut. Where the ball's way up would pass through the model (under an overhang, on the
+//! cut. The ball's way is checked by exact distances to a tessellation of the surface
+//! ([`super::distance`]). Where the ball's way up would pass through the model (under an overhang, on the
 //! underside of a closed part reached with a tilted axis) the tool first backs out along
 //! its own axis, through the space its shank and holder occupied (which the axis search kept
 //! clear), until it is outside the model's box grown by the ball and the clearance; from
 //! there it rises beside the model. Approaches mirror retracts.
 
-use super::axis::Clearance;
+use super::distance::SurfaceDistance;
 use super::toolpath::{Move, MoveKind, Toolpath};
 use super::PlanOptions;
 use crate::geom::{Point3, Vector3};
@@ -19,7 +20,8 @@ use crate::model::Model;
 /// What routing the air moves found.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct AirStats {
-    /// Retracts and approaches moved off the vertical to back out along the tool axis.
+    /// Retracts and approaches that lead off the surface along its normal, or back out
+    /// along the tool axis or the normal, before rising.
     pub escaped: usize,
     /// Retracts and approaches whose ball would pass through the model either way.
     pub blocked: usize,
@@ -29,15 +31,19 @@ pub struct AirStats {
 
 /// Tests whether the ball swept between two points stays out of the model.
 struct Sweep<'a> {
-    obs: &'a Clearance,
-    /// Test radius: the ball less what the samples may miss and the plan's chordal
-    /// tolerance (the ball already touches the surface at the cut point) (mm).
+    dist: &'a SurfaceDistance,
+    /// Least distance from the tessellated surface the ball centre keeps: the ball radius
+    /// less the overcut allowed, plus the tessellation's own deviation (mm).
     rad: f64,
+    /// Length of the lead-off along the contact normal (mm): twice the tessellation's
+    /// deviation and the overcut, so that after it the ball clears the triangles by the
+    /// margin `rad` asks for.
+    lead_mm: f64,
 }
 
 impl Sweep<'_> {
     fn clear(&self, from: &Point3, to: &Point3) -> bool {
-        self.obs.capsule_hit(from, to, self.rad).is_none()
+        !self.dist.segment_within(from, to, self.rad)
     }
 
     /// Whether every leg of `way` (from the cut point on) is clear.
@@ -46,20 +52,30 @@ impl Sweep<'_> {
     }
 }
 
-/// How cut point `p` (ball centre; contact normal `normal`, tool along `axis`) gets up to
-/// the safe plane at `safe_z`: straight up when the ball's way is clear, else backing out
-/// along the first of the tool axis, the contact normal and the normal's horizontal part
-/// whose way out of the grown box and up beside the model is clear.
-fn way_up(sweep: &Sweep, grown: &Bounds, p: &Point3, dirs: &[Vector3], safe_z: f64) -> Way {
-    let up = Point3::new(p.x, p.y, safe_z);
-    if sweep.clear(p, &up) {
-        return Way::Straight;
+/// How cut move `cut` gets up to the safe plane at `safe_z`: the points the ball centre
+/// passes through after leaving it, the last one on the safe plane; `None` if no way tried
+/// is clear. Straight up when that is clear; else first a short lead-off along the contact
+/// normal (it takes the ball a little more than the triangles' tolerance off the surface,
+/// so that what follows can be checked against them with a margin), then straight up, or
+/// backing out along the tool axis, the contact normal or that normal made horizontal to
+/// the edge of the grown box and up beside the model.
+fn way_up(sweep: &Sweep, grown: &Bounds, cut: &Move, safe_z: f64) -> Option<Vec<Point3>> {
+    let p = cut.cl_point;
+    let up = |q: &Point3| Point3::new(q.x, q.y, safe_z);
+    if sweep.clear(&p, &up(&p)) {
+        return Some(vec![up(&p)]);
     }
-    dirs.iter()
+    let normal = (cut.cl_point - cut.cc_point).try_normalize(DIRECTION_MIN)?;
+    let lead = p + normal * sweep.lead_mm;
+    if sweep.clear(&lead, &up(&lead)) {
+        return Some(vec![lead, up(&lead)]);
+    }
+    escape_directions(cut)
+        .iter()
         .filter_map(|d| d.try_normalize(DIRECTION_MIN))
-        .map(|d| grown.exit(p, &d))
-        .find(|e| sweep.clear_way(&[*p, *e, Point3::new(e.x, e.y, safe_z)]))
-        .map_or(Way::Blocked, Way::Escape)
+        .map(|d| grown.exit(&lead, &d))
+        .find(|e| sweep.clear_way(&[lead, *e, up(e)]))
+        .map(|e| vec![lead, e, up(&e)])
 }
 
 /// Shortest direction vector (mm, before normalising) worth trying.
@@ -72,18 +88,18 @@ fn escape_directions(cut: &Move) -> [Vector3; 3] {
     [cut.tool_axis, normal, Vector3::new(normal.x, normal.y, 0.0)]
 }
 
+/// An air move's cut (index), whether it leaves or reaches it, and the way found (`None`:
+/// blocked).
+type AirLeg = (usize, Leg, Option<Vec<Point3>>);
+
 /// Whether an air move leaves a cut or comes down to one.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq)]
 enum Leg {
     Leaving,
     Arriving,
 }
 
-enum Way {
-    Straight,
-    Escape(Point3),
-    Blocked,
-}
+#[derive(Clone, Copy, PartialEq)]
 
 /// An axis-aligned box (mm).
 struct Bounds {
@@ -105,9 +121,28 @@ impl Bounds {
     }
 }
 
+/// What [`route`] did.
+pub enum Routed {
+    /// Every retract and approach found a clear way; the path holds them.
+    Done(AirStats),
+    /// Some found none: these cut points (indices into the path as given) must be left out,
+    /// so that the cut ends (or starts) where the ball can get away; the path is unchanged.
+    LeaveOut(Vec<usize>),
+}
+
+/// Cut points walked along a cut looking for one the tool can leave from.
+const MAX_WALK: usize = 100_000;
+
 /// Routes every retract and approach of `path` around the model (see the module doc). Runs
-/// after the tool axes are set; keeps `runs` and `params` in step with the moves.
-pub fn route(model: &Model, path: &mut Toolpath, opts: &PlanOptions, obs: &Clearance) -> AirStats {
+/// after the tool axes are set; keeps `runs` and `params` in step with the moves. Where no
+/// way is clear, the cut points to leave out are returned instead: from the end of a cut
+/// back (or from its start on) to the first point with a clear way.
+pub fn route(
+    model: &Model,
+    path: &mut Toolpath,
+    opts: &PlanOptions,
+    dist: &SurfaceDistance,
+) -> Routed {
     let bbox = model.surface.bbox();
     let grow = path.tool_radius_mm + opts.clearance_mm;
     let grown = Bounds {
@@ -115,67 +150,86 @@ pub fn route(model: &Model, path: &mut Toolpath, opts: &PlanOptions, obs: &Clear
         hi: [0, 1, 2].map(|k| bbox.max[k] + grow),
     };
     let sweep = Sweep {
-        obs,
-        rad: path.tool_radius_mm - obs.gap_mm() - opts.chordal_mm,
+        dist,
+        rad: path.tool_radius_mm - opts.overcut_mm() + dist.tolerance_mm,
+        lead_mm: 2.0 * dist.tolerance_mm + opts.overcut_mm(),
     };
     let mut stats = AirStats::default();
     if sweep.rad <= 0.0 {
-        return stats;
+        return Routed::Done(stats);
     }
-    let blocked = |stats: &mut AirStats, p: Point3| {
+    let moves = &path.moves;
+    // The cut each air move leaves (the first retract after a cut) or comes down to (the
+    // rapid above the next cut, before its plunge), and the way found.
+    let legs: Vec<Option<AirLeg>> = (0..moves.len())
+        .map(|i| {
+            let m = moves[i];
+            let (cut, leg) = match m.kind {
+                MoveKind::Retract if i > 0 && moves[i - 1].kind.on_surface() => {
+                    (i - 1, Leg::Leaving)
+                }
+                MoveKind::Rapid if moves.get(i + 1).is_some_and(|x| x.kind == MoveKind::Plunge) => {
+                    (i + 1, Leg::Arriving)
+                }
+                _ => return None,
+            };
+            let way = way_up(&sweep, &grown, &moves[cut], m.cl_point.z);
+            Some((cut, leg, way))
+        })
+        .collect();
+    let mut leave_out: Vec<usize> = Vec::new();
+    for (i, leg) in legs.iter().enumerate() {
+        let Some((cut, leg, None)) = leg else {
+            continue;
+        };
+        let (cut, leg) = (*cut, *leg);
         stats.blocked += 1;
-        stats.first_blocked.get_or_insert(p);
-    };
+        stats.first_blocked.get_or_insert(moves[cut].cl_point);
+        let safe_z = moves[i].cl_point.z;
+        let clear_from = |j: usize| way_up(&sweep, &grown, &moves[j], safe_z).is_some();
+        // Walk along the cut, away from the blocked end, to the first point that has a way.
+        let mut j = cut;
+        let mut walked = 0;
+        loop {
+            leave_out.push(j);
+            let next = match leg {
+                Leg::Leaving => j.checked_sub(1),
+                Leg::Arriving => Some(j + 1),
+            };
+            let Some(next) = next.filter(|&k| k < moves.len() && moves[k].kind.on_surface()) else {
+                break;
+            };
+            walked += 1;
+            if walked > MAX_WALK || clear_from(next) {
+                break;
+            }
+            j = next;
+        }
+    }
+    if !leave_out.is_empty() {
+        leave_out.sort_unstable();
+        leave_out.dedup();
+        return Routed::LeaveOut(leave_out);
+    }
     path.rebuild(|old, i, add| {
         let m = old.moves[i];
         let param = old.param(i);
         let mut push = |mv: Move| add(mv, param);
-        // The cut this air move leaves (the first retract after a cut) or comes down to (the
-        // rapid above the next cut, before its plunge).
-        let cut = match m.kind {
-            MoveKind::Retract if i > 0 && old.moves[i - 1].kind.on_surface() => {
-                Some((old.moves[i - 1], Leg::Leaving))
-            }
-            MoveKind::Rapid
-                if old
-                    .moves
-                    .get(i + 1)
-                    .is_some_and(|x| x.kind == MoveKind::Plunge) =>
-            {
-                Some((old.moves[i + 1], Leg::Arriving))
-            }
-            _ => None,
-        };
-        let safe_z = m.cl_point.z;
-        match cut.map(|(cut, leg)| {
-            let way = way_up(
-                &sweep,
-                &grown,
-                &cut.cl_point,
-                &escape_directions(&cut),
-                safe_z,
-            );
-            (way, cut, leg)
-        }) {
-            Some((Way::Escape(e), _, leg)) => {
+        match &legs[i] {
+            Some((_, leg, Some(way))) if way.len() > 1 => {
                 stats.escaped += 1;
-                let above = Point3::new(e.x, e.y, safe_z);
-                let points = match leg {
-                    Leg::Leaving => [e, above],
-                    Leg::Arriving => [above, e],
-                };
+                let mut points = way.clone();
+                if *leg == Leg::Arriving {
+                    points.reverse();
+                }
                 for p in points {
                     push(Move { cl_point: p, ..m });
                 }
             }
-            Some((Way::Blocked, cut, _)) => {
-                blocked(&mut stats, cut.cl_point);
-                push(m);
-            }
             _ => push(m),
         }
     });
-    stats
+    Routed::Done(stats)
 }
 
 #[cfg(test)]

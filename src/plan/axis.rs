@@ -13,6 +13,7 @@
 //! continuously as the tool nears a wall, so the axis turns gradually without smoothing,
 //! and it is +Z wherever +Z is clear.
 
+use super::reach::Why;
 use super::toolpath::{Move, MoveKind, Toolpath};
 use super::PlanOptions;
 use crate::error::{Error, Result};
@@ -591,8 +592,6 @@ pub struct AxisStats {
     pub margin_mm: f64,
     /// The end of the first of those (ball centre, mm).
     pub first_sweep_hit: Option<Point3>,
-    /// How the retracts and approaches were routed around the model.
-    pub air: super::air::AirStats,
 }
 
 /// Turn of the tool axis between the poses checked while it turns from one cut point to
@@ -600,14 +599,16 @@ pub struct AxisStats {
 const SWEEP_STEP_DEG: f64 = 2.0;
 
 /// True if a pose between cut points `a` and `b` (ball centre and axis interpolated
-/// linearly, every [`SWEEP_STEP_DEG`] of turn) puts the shank or holder into the model.
+/// linearly, every [`SWEEP_STEP_DEG`] of turn and at most the samples' gap of travel apart)
+/// puts the shank or holder into the model.
 fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool {
     let step = SWEEP_STEP_DEG.to_radians();
     let turn = a.tool_axis.angle(&b.tool_axis);
-    if turn <= step {
+    let travel = (b.cl_point - a.cl_point).norm();
+    let poses = ((turn / step).ceil() as usize).max((travel / obs.gap_mm()).ceil() as usize);
+    if poses <= 1 {
         return false;
     }
-    let poses = (turn / step).ceil() as usize;
     let (na, nb) = (contact_normal(a), contact_normal(b));
     (1..poses).any(|k| {
         let s = k as f64 / poses as f64;
@@ -677,7 +678,12 @@ fn bridge(
 /// Splits every turn of the axis between two cut points whose in-between poses would put
 /// the shank or holder into the model (see [`bridge`]); counts the splits and the turns
 /// that stay blocked.
-fn bridge_turns(path: &mut Toolpath, obs: &Clearance, opts: &PlanOptions, stats: &mut AxisStats) {
+pub fn bridge_turns(
+    path: &mut Toolpath,
+    obs: &Clearance,
+    opts: &PlanOptions,
+    stats: &mut AxisStats,
+) {
     path.rebuild(|old, i, add| {
         let b = old.moves[i];
         let q = old.param(i);
@@ -714,20 +720,20 @@ fn bridge_turns(path: &mut Toolpath, obs: &Clearance, opts: &PlanOptions, stats:
 /// Shortest interpolated axis (before normalising) taken as a direction.
 const AXIS_MIN_NORM: f64 = 1e-9;
 
-/// Sets the tool axis of every move of `path`. With `max_tilt_deg` 0 (three-axis) the axis
-/// stays +Z and collisions are counted; otherwise a point where no allowed axis is clear is
-/// an error.
-pub fn assign(
-    model: &Model,
+/// Sets the tool axis of every cutting move of `path` (moves off the surface are left for
+/// [`fill_air_axes`]): +Z where the shank and holder clear the model, else the least clear
+/// tilt (up to `max_tilt_deg`; 0 plans three-axis). Returns what it found and, per move,
+/// why it cannot be cut where no allowed axis is usable (the move keeps +Z then).
+pub fn choose(
+    obs: &Clearance,
     path: &mut Toolpath,
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
-) -> Result<AxisStats> {
-    let obs = Clearance::new(model, opts);
+) -> Result<(AxisStats, Vec<Option<Why>>)> {
     let n = path.moves.len();
-    let mut axes: Vec<Vector3> = vec![Vector3::z(); n];
     let mut prev = Vector3::z();
     let mut stats = AxisStats::default();
+    let mut why: Vec<Option<Why>> = vec![None; n];
     for i in 0..n {
         let m = path.moves[i];
         if !m.kind.on_surface() {
@@ -759,18 +765,18 @@ pub fn assign(
             let side = normal.cross(&feed);
             let a = rotate(&normal, &side, opts.lead_deg.to_radians());
             let a = rotate(&a, &feed, opts.tilt_deg.to_radians());
-            if usable(&obs, (&c, &normal), &a, opts) {
+            if usable(obs, (&c, &normal), &a, opts) {
                 axis = a;
             }
         }
         let blocked_at = if axis == Vector3::z() {
-            vertical_hit(&obs, (&c, &normal), &m.cc_point, opts)
+            vertical_hit(obs, (&c, &normal), &m.cc_point, opts)
         } else {
             None
         };
         if let Some(h) = blocked_at {
             match (opts.max_tilt_deg > 0.0)
-                .then(|| clear_axis(&obs, (&c, &normal), opts, &prev, &h))
+                .then(|| clear_axis(obs, (&c, &normal), opts, &prev, &h))
                 .flatten()
             {
                 Some(a) => {
@@ -779,57 +785,54 @@ pub fn assign(
                 }
                 None => {
                     stats.blocked += 1;
-                    if normal.z < MIN_AXIS_NORMAL_COS {
+                    // Facing away from every allowed axis: the normal further from +Z than
+                    // the largest tilt and the most the axis may lean from the normal.
+                    let from_z = normal.z.clamp(-1.0, 1.0).acos();
+                    let faces_away = from_z
+                        > opts.max_tilt_deg.max(0.0).to_radians() + MIN_AXIS_NORMAL_COS.acos();
+                    if faces_away {
                         stats.facing_away += 1;
+                        why[i] = Some(Why::FacesAway);
+                    } else {
+                        why[i] = Some(Why::ToolHits);
                     }
                     stats.first_blocked.get_or_insert(c);
                 }
             }
         }
-        axes[i] = axis;
-        prev = axis;
+        path.moves[i].tool_axis = axis;
+        if why[i].is_none() {
+            prev = axis;
+        }
         if i % 512 == 0 && !progress(i as f64 / n as f64) {
             return Err(Error::Cancelled);
         }
     }
-    // Moves off the surface keep the axis of the nearest cut.
+    stats.margin_mm = obs.gap_mm();
+    progress(1.0);
+    Ok((stats, why))
+}
+
+/// Gives every move off the surface the tool axis of the nearest cut: retracts keep the
+/// axis of the cut they leave, rapids take that of the cut they come down to.
+pub fn fill_air_axes(path: &mut Toolpath) {
+    let n = path.moves.len();
     let mut last = None;
     for i in 0..n {
         if path.moves[i].kind.on_surface() {
-            last = Some(axes[i]);
+            last = Some(path.moves[i].tool_axis);
         } else if let Some(a) = last {
-            axes[i] = a;
+            path.moves[i].tool_axis = a;
         }
     }
     let mut next = None;
     for i in (0..n).rev() {
         if path.moves[i].kind.on_surface() {
-            next = Some(axes[i]);
+            next = Some(path.moves[i].tool_axis);
         } else if path.moves[i].kind == MoveKind::Rapid {
             if let Some(a) = next {
-                axes[i] = a;
+                path.moves[i].tool_axis = a;
             }
         }
     }
-    for (m, a) in path.moves.iter_mut().zip(&axes) {
-        m.tool_axis = *a;
-    }
-    stats.margin_mm = obs.gap_mm();
-    bridge_turns(path, &obs, opts, &mut stats);
-    stats.air = super::air::route(model, path, opts, &obs);
-    if stats.blocked > 0 && opts.max_tilt_deg > 0.0 {
-        let p = stats.first_blocked.unwrap_or_else(Point3::origin);
-        return Err(Error::Degenerate {
-            location: format!(
-                "{} points of the path, the first at ball centre ({:.3}, {:.3}, {:.3}) mm",
-                stats.blocked, p.x, p.y, p.z
-            ),
-            message: format!(
-                "no tool axis within {}° of +Z both comes from the side the surface faces and keeps the shank and holder clear of the model: use a longer shank, a smaller holder or allow more tilt (a table tilting past upright reaches undersides)",
-                opts.max_tilt_deg
-            ),
-        });
-    }
-    progress(1.0);
-    Ok(stats)
 }

@@ -12,6 +12,7 @@
 use super::{MoveKind, Toolpath};
 use crate::error::{Error, Result};
 use crate::geom::{Aabb, Point3};
+use crate::model::Model;
 use crate::surface::Surface;
 use crate::tmesh::{Scheme, TMesh};
 
@@ -131,20 +132,36 @@ impl<'a> Nearest<'a> {
 
 /// True if the surface may have C0 knot lines (creases): only repeated knots, that is zero
 /// knot intervals, put them in a T-spline; Catmull–Clark limit surfaces are G1 everywhere.
-/// The planner runs [`lift`] only then (it costs about as much as the rest of a keycap plan).
 pub fn may_crease(mesh: &TMesh) -> bool {
     mesh.scheme() == Scheme::TSpline && mesh.half_edges().iter().any(|h| h.knot == 0.0)
 }
 
+/// True if a ball of radius `r` placed by its contact normal may cut into the surface
+/// elsewhere: the surface may crease, or somewhere it is concave (towards the tool) with a
+/// radius below the ball's (within [`TIGHT_MARGIN`]). The planner runs [`lift`] only then
+/// (it costs about as much as the rest of a keycap plan).
+pub fn needed(model: &Model, r: f64) -> bool {
+    may_crease(&model.mesh)
+        || model
+            .smallest_concave_radius()
+            .is_some_and(|c| c.radius_mm < r * (1.0 + TIGHT_MARGIN))
+}
+
+/// Relative margin on the tool radius below which a concave radius counts as tight: the
+/// smallest radius is sampled, and may lie lower between samples.
+const TIGHT_MARGIN: f64 = 0.25;
+
 /// Lifts every cutting CL point of `path` whose ball of radius `r` cuts into the surface by
 /// more than `tol` mm, until it is a radius from the nearest surface point (within `tol`).
-/// The contact point becomes that nearest point.
+/// The contact point becomes that nearest point; `left[i]` becomes the material the lifted
+/// ball leaves at move `i`'s old contact point (mm; untouched for moves not lifted).
 /// `keep_going` is asked every few hundred moves; false cancels.
 pub fn lift(
     surface: &Surface,
     path: &mut Toolpath,
     r: f64,
     tol: f64,
+    left: &mut [f64],
     keep_going: &mut dyn FnMut() -> bool,
 ) -> Result<GougeStats> {
     let near = Nearest::new(surface);
@@ -185,6 +202,9 @@ pub fn lift(
         if depth > tol {
             stats.residual += 1;
             stats.residual_mm = stats.residual_mm.max(depth);
+        }
+        if let Some(l) = left.get_mut(i) {
+            *l = ((c - m.cc_point).norm() - r).max(0.0);
         }
         m.cl_point = c;
         m.cc_point = contact;

@@ -10,10 +10,12 @@
 //! shared corner, joined by a feed move.
 
 use super::corners::{self, Crossfeed};
+use super::draft::{Draft, DraftBuilder, Footprint, SurfacePoint};
 use super::order::{self, CostMatrix};
+use super::pipeline::Planned;
 use super::stepover::{self, FeedDir};
-use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
-use super::{axis, PlanOptions};
+use super::toolpath::{PatchRun, Toolpath};
+use super::PlanOptions;
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
 use crate::layout::{ConnectionKind, Patch};
@@ -51,17 +53,24 @@ const CORNER_MATCH_REL: f64 = 1e-7;
 pub trait ParamSurface {
     fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs;
     fn subs(&self, u: f64, v: f64) -> Point3;
-    /// Unit normal, taken from nearby where the surface is singular.
+    /// Unit normal on the tool's side, taken from nearby where the surface is singular.
     fn normal(&self, u: f64, v: f64) -> Option<Vector3>;
     /// Where this is, for error messages.
     fn label(&self) -> String;
+    /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other.
+    fn side(&self) -> f64 {
+        1.0
+    }
 }
 
-/// A layout patch of a surface.
+/// A layout patch of a surface, seen from the side the tool works from.
 pub struct PatchView<'a> {
     pub index: usize,
     pub patch: &'a Patch,
     pub surface: &'a Surface,
+    /// +1: the tool works from the side `S_u × S_v` points to; −1: from the other
+    /// ([`Model::tool_side`]).
+    pub side: f64,
 }
 
 impl ParamSurface for PatchView<'_> {
@@ -72,7 +81,10 @@ impl ParamSurface for PatchView<'_> {
         self.patch.subs(self.surface, u, v)
     }
     fn normal(&self, u: f64, v: f64) -> Option<Vector3> {
-        self.patch.normal(self.surface, u, v)
+        self.patch.normal(self.surface, u, v).map(|n| n * self.side)
+    }
+    fn side(&self) -> f64 {
+        self.side
     }
     fn label(&self) -> String {
         format!("patch {}", self.index)
@@ -82,7 +94,8 @@ impl ParamSurface for PatchView<'_> {
 /// Fundamental forms at a point; `None` at a singular point (an extraordinary point's limit),
 /// where curvature is undefined and must not enter step computations.
 fn geom_at(s: &dyn ParamSurface, u: f64, v: f64) -> Option<DiffGeom> {
-    DiffGeom::try_from_derivs(&s.derivs(u, v))
+    let g = DiffGeom::try_from_derivs(&s.derivs(u, v))?;
+    Some(if s.side() < 0.0 { g.flipped() } else { g })
 }
 
 /// Point on the pass at fixed `w` (the across-parameter), moving parameter `t`.
@@ -93,23 +106,18 @@ fn at(dir: FeedDir, t: f64, w: f64) -> (f64, f64) {
     }
 }
 
-/// Parametric side step from the pass at `w` for scallop `h`: the smallest over the pass.
-fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> Result<f64> {
+/// Parametric side step from the pass at `w` for scallop `h`: the smallest over the pass
+/// (concave curvature tighter than the ball clamped, see [`stepover::side_step_clamped`]).
+fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> f64 {
     let mut best = f64::INFINITY;
     for t in pass_samples() {
         let (u, v) = at(dir, t, w);
         let Some(dg) = geom_at(s, u, v) else { continue };
         let kappa = stepover::cross_curvature(&dg, dir);
-        let g = stepover::side_step(h, r, kappa).map_err(|e| match e {
-            Error::Degenerate { message, .. } => Error::Degenerate {
-                location: format!("{} at (u, v) = ({u:.4}, {v:.4})", s.label()),
-                message,
-            },
-            other => other,
-        })?;
+        let g = stepover::side_step_clamped(h, r, kappa);
         best = best.min(stepover::param_side_step(&dg, dir, g));
     }
-    Ok(best)
+    best
 }
 
 /// Largest scallop predicted by eq. 5 between passes `w` and `w + dw`, sampled on both
@@ -145,7 +153,7 @@ impl StepProfile {
     pub fn new(s: &dyn ParamSurface, dir: FeedDir, h0: f64, r: f64) -> Result<Self> {
         let d = (0..=PROFILE_INTERVALS)
             .map(|i| required_step(s, dir, i as f64 / PROFILE_INTERVALS as f64, h0, r))
-            .collect::<Result<Vec<f64>>>()?;
+            .collect();
         Ok(StepProfile { d, h0 })
     }
 
@@ -254,6 +262,135 @@ fn tuned_passes(
     done(ws, hi)
 }
 
+/// Material left along the unit normal `n` at surface point `q` by a ball of radius `r`
+/// swept along the line through `c` with unit direction `e` (a cylinder: the swept ball
+/// near a point of its pass), in mm, negative if `q` is inside; infinity if the normal
+/// line misses it.
+fn left_by_swept_ball(q: &Point3, n: &Vector3, (c, e): (&Point3, &Vector3), r: f64) -> f64 {
+    let d = c - q;
+    let (dp, np) = (d - e * d.dot(e), n - e * n.dot(e));
+    let a = np.norm_squared();
+    if a < SWEEP_PARALLEL {
+        // The normal runs along the pass: the ball itself.
+        let b = d.dot(n);
+        let disc = b * b - (d.norm_squared() - r * r);
+        return if disc < 0.0 {
+            f64::INFINITY
+        } else {
+            b - disc.sqrt()
+        };
+    }
+    let b = np.dot(&dp);
+    let disc = b * b - a * (dp.norm_squared() - r * r);
+    if disc < 0.0 {
+        f64::INFINITY
+    } else {
+        (b - disc.sqrt()) / a
+    }
+}
+
+/// Below this squared sine the surface normal runs along the pass (dimensionless).
+const SWEEP_PARALLEL: f64 = 1e-12;
+/// Parameter step of the finite difference giving a pass's direction.
+const TANGENT_STEP: f64 = 1e-5;
+
+/// Bisection steps locating the cusp between two passes (to 2⁻¹² of their gap).
+const CUSP_BISECTIONS: usize = 12;
+/// Relative excess of a cusp over its target tolerated before its gap is split: eq. 5 spaces
+/// passes for the target itself, so its cusps reach it to rounding; kinks exceed it by far.
+const CUSP_SLACK: f64 = 0.02;
+/// Times a gap between passes is split in three before its cusp is left as it is.
+const CUSP_SPLITS: usize = 4;
+
+/// The highest cusp between the passes at `w0` and `w1` (mm): at samples of the passes, the
+/// material left at the point between them where the two passes' swept balls (centred a
+/// radius along the surface normal from the contact points, swept along the ball-centre
+/// curve's tangent) leave equal material, found by bisection along the iso-line across.
+fn cusp_between(s: &dyn ParamSurface, dir: FeedDir, w0: f64, w1: f64, r: f64) -> Result<f64> {
+    let mut worst: f64 = 0.0;
+    for t in pass_samples() {
+        let sweep = |w: f64| -> Result<(Point3, Vector3)> {
+            let cl = |t: f64| -> Result<Point3> {
+                let (p, n) = pass_point(s, dir, t, w)?;
+                Ok(p + n * r)
+            };
+            let (ta, tb) = ((t - TANGENT_STEP).max(0.0), (t + TANGENT_STEP).min(1.0));
+            let e = (cl(tb)? - cl(ta)?)
+                .try_normalize(0.0)
+                .unwrap_or_else(Vector3::zeros);
+            Ok((cl(t)?, e))
+        };
+        let (s0, s1) = (sweep(w0)?, sweep(w1)?);
+        // Material left by each pass at fraction x of the way across.
+        let left = |x: f64| -> Result<(f64, f64)> {
+            let (q, n) = pass_point(s, dir, t, w0 + x * (w1 - w0))?;
+            Ok((
+                left_by_swept_ball(&q, &n, (&s0.0, &s0.1), r),
+                left_by_swept_ball(&q, &n, (&s1.0, &s1.1), r),
+            ))
+        };
+        let (mut lo, mut hi) = (0.0, 1.0);
+        let mut best = f64::INFINITY;
+        for _ in 0..CUSP_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            let (a, b) = left(mid)?;
+            best = best.min(a.max(b));
+            if a < b {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        // The cusp lies between the lesser of the two at the bracket's ends and the least
+        // of the greater over the bisection: take the upper end, unless a ball was missed.
+        let cusp = if best.is_finite() {
+            best
+        } else {
+            let (a0, b0) = left(lo)?;
+            let (a1, b1) = left(hi)?;
+            a0.min(b0).max(a1.min(b1))
+        };
+        if cusp.is_finite() {
+            worst = worst.max(cusp);
+        }
+    }
+    Ok(worst)
+}
+
+/// Checks the cusp between every two adjacent passes `ws` against `h` (mm); a gap whose
+/// cusp is higher gets two more passes (splitting it in three keeps the count's parity, and
+/// so the corner the zig-zag ends at), up to [`CUSP_SPLITS`] times. Returns the passes and
+/// the highest cusp left.
+fn cusp_checked(
+    s: &dyn ParamSurface,
+    dir: FeedDir,
+    ws: Vec<f64>,
+    h: f64,
+    r: f64,
+) -> Result<(Vec<f64>, f64)> {
+    let mut out = vec![ws[0]];
+    let mut worst: f64 = 0.0;
+    for pair in ws.windows(2) {
+        // Gaps still to check, last first, with how often each was split.
+        let mut todo = vec![(pair[0], pair[1], 0usize)];
+        while let Some((a, b, depth)) = todo.pop() {
+            let c = cusp_between(s, dir, a, b, r)?;
+            if c > h * (1.0 + CUSP_SLACK) && depth < CUSP_SPLITS {
+                let d = (b - a) / 3.0;
+                todo.extend([
+                    (a + 2.0 * d, b, depth + 1),
+                    (a + d, a + 2.0 * d, depth + 1),
+                    (a, a + d, depth + 1),
+                ]);
+                continue;
+            }
+            worst = worst.max(c);
+            out.push(b);
+        }
+    }
+    Ok((out, worst))
+}
+
 /// Distance from `p` to the segment `a`–`b`.
 fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
     let ab = b - a;
@@ -276,17 +413,26 @@ fn pass_point(s: &dyn ParamSurface, dir: FeedDir, t: f64, w: f64) -> Result<(Poi
     Ok((s.subs(u, v), n))
 }
 
-/// Moving-parameter values along the pass at `w` so that chords of the contact curve stay
-/// within `tol` (mm), and chords of the ball-centre curve within `tol` where they dip into
-/// the surface (an overcut) and within `leave` where they pass above it (material left,
-/// which adds to the scallop).
+/// How far a straight move may stray from the curve it replaces (mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChordLimits {
+    /// Chord of the contact curve from the curve, either way.
+    pub contact: f64,
+    /// Chord of the ball-centre curve below that curve: the ball cuts into the surface.
+    pub overcut: f64,
+    /// Chord of the ball-centre curve above it: material left, which adds to the scallop.
+    pub leave: f64,
+}
+
+/// Moving-parameter values along the pass at `w` so that chords stay within `lim`.
 pub fn forward_steps(
     s: &dyn ParamSurface,
     dir: FeedDir,
     w: f64,
-    (tol, leave): (f64, f64),
+    lim: ChordLimits,
     r: f64,
 ) -> Result<Vec<f64>> {
+    let (tol, dip, leave) = (lim.contact, lim.overcut, lim.leave);
     let mut ts = vec![0.0];
     let mut t = 0.0;
     let mut p0 = pass_point(s, dir, 0.0, w)?;
@@ -310,7 +456,7 @@ pub fn forward_steps(
             2.0 * k
         };
         let first = if speed > 0.0 {
-            stepover::chord_step(tol, k_cl) / speed
+            stepover::chord_step(tol.min(dip), k_cl) / speed
         } else {
             1e-3
         };
@@ -334,7 +480,7 @@ pub fn forward_steps(
                 };
                 let off = m - (a + ab * along);
                 // The curve above the chord (along the normal): the chord dips into the material.
-                let cl_tol = if off.dot(&pm.1) >= 0.0 { tol } else { leave };
+                let cl_tol = if off.dot(&pm.1) >= 0.0 { dip } else { leave };
                 if dist_to_segment(&pm.0, &p0.0, &p1.0) > tol || off.norm() > cl_tol {
                     ok = false;
                     break;
@@ -357,96 +503,6 @@ pub fn forward_steps(
         p0 = p1;
     }
     Ok(ts)
-}
-
-/// A planned path with its patch order.
-#[derive(Debug, Clone)]
-pub struct Planned {
-    pub toolpath: Toolpath,
-    /// Retractions the layout forced (no non-retraction order and corners existed).
-    pub forced_retractions: usize,
-    /// What the tool-axis assignment found.
-    pub axes: axis::AxisStats,
-    /// CL points lifted where the ball cut into another face (a crease).
-    pub gouge: super::gouge::GougeStats,
-}
-
-/// Share of the chordal tolerance by which a ball may cut into the surface at a CL point
-/// before the point is lifted (the rest is left to the straight moves between points).
-const GOUGE_LIFT_SHARE: f64 = 0.2;
-
-impl Planned {
-    /// The report of this plan, with notes on forced retractions and collisions.
-    pub fn report(&self, opts: &PlanOptions) -> super::PlanReport {
-        let mut r =
-            self.toolpath
-                .report("isoparametric", opts.feed_mm_min, opts.plunge_feed_mm_min);
-        if self.forced_retractions > 0 {
-            r.notes.push(format!(
-                "no patch order and transit corners avoid retractions on this layout: {} retraction(s) used",
-                self.forced_retractions
-            ));
-        }
-        if let Some(p) = self.gouge.worst_at {
-            r.notes.push(format!(
-                "at {} points the ball, placed by its own face's normal, cut into a neighbouring face (a crease in the surface) by up to {:.4} mm, the deepest at ball centre ({:.3}, {:.3}, {:.3}) mm: they were lifted to touch both faces",
-                self.gouge.lifted, self.gouge.worst_mm, p.x, p.y, p.z
-            ));
-        }
-        if self.gouge.residual > 0 {
-            r.notes.push(format!(
-                "{} points stay up to {:.4} mm inside the surface after lifting",
-                self.gouge.residual, self.gouge.residual_mm
-            ));
-        }
-        if self.axes.tilted > 0 {
-            r.notes.push(format!(
-                "the tool axis tilts away from +Z at {} points to keep the shank and holder clear",
-                self.axes.tilted
-            ));
-        }
-        if let Some(p) = self.axes.first_blocked {
-            let (blocked, away) = (self.axes.blocked, self.axes.facing_away);
-            let why = match (away, blocked - away) {
-                (0, _) => "the shank or holder would hit the model".to_string(),
-                (_, 0) => "the surface faces away from +Z (the tool would come from behind it)"
-                    .to_string(),
-                (a, h) => format!(
-                    "at {a} the surface faces away from +Z (the tool would come from behind it), at {h} the shank or holder would hit the model"
-                ),
-            };
-            r.notes.push(format!(
-                "with the tool axis at +Z {blocked} points cannot be cut, the first at ball centre ({:.3}, {:.3}, {:.3}) mm: {why}; use a five-axis machine, a longer shank or a smaller holder",
-                p.x, p.y, p.z
-            ));
-        }
-        if self.axes.bridged > 0 {
-            r.notes.push(format!(
-                "at {} moves the tool axis turns in smaller steps through added cut points, so that the shank and holder stay clear while it turns",
-                self.axes.bridged
-            ));
-        }
-        if let Some(p) = self.axes.first_sweep_hit {
-            r.notes.push(format!(
-                "at {} moves the shank or holder comes within the {:.2} mm safety margin of the model (and may touch it) while the tool axis turns between two cut points, the first ending at ball centre ({:.3}, {:.3}, {:.3}) mm: allow more tilt, use a longer shank or a smaller holder",
-                self.axes.sweep_hits, self.axes.margin_mm, p.x, p.y, p.z
-            ));
-        }
-        let air = &self.axes.air;
-        if air.escaped > 0 {
-            r.notes.push(format!(
-                "{} retract(s) or approach(es) back away from the surface (along the tool axis or the surface normal) before rising, to keep the ball out of the model",
-                air.escaped
-            ));
-        }
-        if let Some(p) = air.first_blocked {
-            r.notes.push(format!(
-                "{} retract(s) or approach(es) pass through the model whichever way they go, the first from ball centre ({:.3}, {:.3}, {:.3}) mm: use a five-axis machine or allow more tilt",
-                air.blocked, p.x, p.y, p.z
-            ));
-        }
-        r
-    }
 }
 
 /// Identity of each patch corner: corners at the same point share an id.
@@ -534,13 +590,29 @@ fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
     }
 }
 
-/// Plans the whole model: patch order, transit corners, per-patch zig-zags, tool axes.
-/// `progress` receives the fraction done and returns `false` to cancel.
+/// Plans the whole model: the zig-zags ([`draft`]) through the shared pipeline (tool
+/// axes, lifting, rest area, air moves). `progress` receives the fraction done and returns
+/// `false` to cancel.
 pub fn plan(
     model: &Model,
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Planned> {
+    let d = draft(model, opts, &mut |f| progress(DRAFT_SHARE * f))?;
+    super::pipeline::finish(model, d, opts, &mut |f| {
+        progress(DRAFT_SHARE + (1.0 - DRAFT_SHARE) * f)
+    })
+}
+
+/// Share of the progress bar the zig-zags take (the pipeline takes the rest).
+const DRAFT_SHARE: f64 = 0.7;
+
+/// The patch order, transit corners and per-patch zig-zags, as a draft for the pipeline.
+pub fn draft(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<Draft> {
     opts.validate()?;
     let np = model.layout.len();
     if np == 0 {
@@ -574,6 +646,7 @@ pub fn plan(
             index,
             patch,
             surface: &model.surface,
+            side: model.tool_side(),
         })
         .collect();
     let preferred: Vec<Crossfeed> = views
@@ -592,10 +665,7 @@ pub fn plan(
     let ids = corner_ids(model);
     let order = order::patch_order(&costs, start, finish);
     let (transits, forced) = corners::select(&order, &ids, &preferred, None);
-    let safe_z = model.surface.bbox().max[2] + 2.0 * r + opts.clearance_mm;
-    let mut moves: Vec<Move> = Vec::new();
-    // Patch parameters of each move, filled as moves are added.
-    let mut params: Vec<[f64; 2]> = Vec::new();
+    let mut out = DraftBuilder::new(model, opts);
     let mut runs: Vec<PatchRun> = Vec::new();
     let mut worst: f64 = 0.0;
     for (k, tr) in transits.iter().enumerate() {
@@ -614,8 +684,12 @@ pub fn plan(
         let h_target = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
         let h_side = h_target / (1.0 + h_target / (2.0 * r));
         let leave = opts.chordal_mm.min(CHORD_SCALLOP_SHARE * opts.scallop_mm);
-        let (mut ws, h_used, pred) = tuned_passes(view, dir, odd, h_side, r)?;
-        worst = worst.max(pred);
+        let (ws, h_used, pred) = tuned_passes(view, dir, odd, h_side, r)?;
+        // Eq. 5 sees the curvature of each face, not the kinks between faces (a convex
+        // crease between two passes widens their cusp by about r times its angle): the
+        // cusps between the passes are computed from the two balls and split where too high.
+        let (mut ws, cusp) = cusp_checked(view, dir, ws, h_target, r)?;
+        worst = worst.max(pred).max(cusp);
         // The passes start on the start corner's side and each runs away from the corner's
         // coordinate along the pass first.
         let (w_start, t_start) = match dir {
@@ -625,71 +699,75 @@ pub fn plan(
         if w_start == 1 {
             ws.reverse();
         }
-        let first_move = moves.len();
+        let first_move = out.len();
         let nlines = ws.len();
+        let patch = tr.patch as u32;
+        // The strip across the passes each pass stands for: half-way to its neighbours.
+        let strip = |li: usize| -> (f64, f64) {
+            let w = ws[li];
+            let lo = if li > 0 { 0.5 * (ws[li - 1] + w) } else { w };
+            let hi = if li + 1 < nlines {
+                0.5 * (w + ws[li + 1])
+            } else {
+                w
+            };
+            (lo.min(hi), lo.max(hi))
+        };
         for (li, &w) in ws.iter().enumerate() {
-            let mut ts = forward_steps(view, dir, w, (CHORD_MARGIN * opts.chordal_mm, leave), r)?;
+            let limits = ChordLimits {
+                contact: CHORD_MARGIN * opts.chordal_mm,
+                overcut: CHORD_MARGIN * opts.overcut_mm(),
+                leave,
+            };
+            let mut ts = forward_steps(view, dir, w, limits, r)?;
             let reversed = (li % 2 == 1) != (t_start == 1);
             if reversed {
                 ts = ts.iter().rev().copied().collect();
             }
+            let (w0, w1) = strip(li);
             for (j, &t) in ts.iter().enumerate() {
                 let (cc, n) = pass_point(view, dir, t, w)?;
-                let cl = cc + n * r;
                 let (pu, pv) = at(dir, t, w);
-                let mv = |kind| Move {
-                    kind,
-                    cc_point: cc,
-                    cl_point: cl,
-                    tool_axis: Vector3::z(),
-                    patch: tr.patch as u32,
-                    line: li as u32,
+                let p = SurfacePoint {
+                    patch,
+                    uv: [pu, pv],
+                    cc,
+                    normal: n,
                 };
+                // Along the pass: half-way to the neighbouring points.
+                let t0 = if j > 0 { 0.5 * (ts[j - 1] + t) } else { t };
+                let t1 = if j + 1 < ts.len() {
+                    0.5 * (t + ts[j + 1])
+                } else {
+                    t
+                };
+                let (t0, t1) = (t0.min(t1), t0.max(t1));
+                let fp = Footprint {
+                    patch,
+                    rect: match dir {
+                        FeedDir::AlongU => [t0, t1, w0, w1],
+                        FeedDir::AlongV => [w0, w1, t0, t1],
+                    },
+                };
+                let line = li as u32;
                 if j == 0 {
                     if li == 0 {
                         if k == 0 || tr.retract_before {
-                            if let Some(last) = moves.last().copied() {
-                                moves.push(Move {
-                                    kind: MoveKind::Retract,
-                                    cl_point: Point3::new(last.cl_point.x, last.cl_point.y, safe_z),
-                                    ..last
-                                });
-                                params.push(*params.last().unwrap_or(&[pu, pv]));
-                            }
-                            moves.push(Move {
-                                cl_point: Point3::new(cl.x, cl.y, safe_z),
-                                ..mv(MoveKind::Rapid)
-                            });
-                            moves.push(mv(MoveKind::Plunge));
-                            params.extend([[pu, pv], [pu, pv]]);
+                            out.approach(&p, line, fp);
                         } else {
                             // Transit from the previous patch's finishing corner.
-                            moves.push(mv(MoveKind::Link));
-                            params.push([pu, pv]);
+                            out.link(&p, line, fp);
                         }
                     } else {
-                        link_between(
-                            view,
-                            dir,
-                            (&mut moves, &mut params),
-                            ws[li - 1],
-                            w,
-                            t,
-                            opts,
-                            r,
-                            tr.patch,
-                            li,
-                        )?;
-                        moves.push(mv(MoveKind::Link));
-                        params.push([pu, pv]);
+                        link_between(view, dir, &mut out, ws[li - 1], w, t, opts, r, patch, line)?;
+                        out.link(&p, line, fp);
                     }
                 } else {
-                    moves.push(mv(MoveKind::Feed));
-                    params.push([pu, pv]);
+                    out.feed(&p, line, fp);
                 }
             }
             let frac = (k as f64 + (li + 1) as f64 / nlines as f64) / transits.len() as f64;
-            if !progress(0.8 * frac) {
+            if !progress(frac) {
                 return Err(Error::Cancelled);
             }
         }
@@ -702,59 +780,27 @@ pub fn plan(
             scallop_used_mm: h_used,
             retract_before: tr.retract_before || k == 0,
             first_move,
-            last_move: moves.len() - 1,
+            last_move: out.len() - 1,
         });
     }
-    if let Some(last) = moves.last().copied() {
-        moves.push(Move {
-            kind: MoveKind::Retract,
-            cl_point: Point3::new(last.cl_point.x, last.cl_point.y, safe_z),
-            ..last
-        });
-        params.push(*params.last().unwrap_or(&[0.0, 0.0]));
-    }
-    let mut toolpath = Toolpath {
-        tool_radius_mm: r,
-        moves,
-        max_predicted_scallop_mm: worst,
-        runs,
-        params,
-    };
-    let gouge = if super::gouge::may_crease(&model.mesh) {
-        super::gouge::lift(
-            &model.surface,
-            &mut toolpath,
-            r,
-            GOUGE_LIFT_SHARE * opts.chordal_mm,
-            &mut || progress(0.8),
-        )?
-    } else {
-        super::gouge::GougeStats::default()
-    };
-    let axes = axis::assign(model, &mut toolpath, opts, &mut |f| progress(0.8 + 0.2 * f))?;
-    Ok(Planned {
-        toolpath,
-        forced_retractions: forced,
-        axes,
-        gouge,
-    })
+    Ok(out.finish("isoparametric", runs, worst, forced))
 }
 
 /// Feed moves along the patch boundary from pass `w0` to pass `w1` at parameter `t`, split
 /// where one straight link would leave the chordal tolerance (the last point is added by the
-/// caller).
+/// caller). They add no area of their own: the passes' footprints cover the boundary.
 #[allow(clippy::too_many_arguments)]
 fn link_between(
     s: &dyn ParamSurface,
     dir: FeedDir,
-    (moves, params): (&mut Vec<Move>, &mut Vec<[f64; 2]>),
+    out: &mut DraftBuilder,
     w0: f64,
     w1: f64,
     t: f64,
     opts: &PlanOptions,
     r: f64,
-    patch: usize,
-    line: usize,
+    patch: u32,
+    line: u32,
 ) -> Result<()> {
     let other = match dir {
         FeedDir::AlongU => FeedDir::AlongV,
@@ -772,7 +818,7 @@ fn link_between(
             let p1 = pass_point(s, other, cur + dt, t)?;
             let cl = |p: &(Point3, Vector3)| p.0 + p.1 * r;
             if dist_to_segment(&pm.0, &p0.0, &p1.0) <= opts.chordal_mm
-                && dist_to_segment(&cl(&pm), &cl(&p0), &cl(&p1)) <= opts.chordal_mm
+                && dist_to_segment(&cl(&pm), &cl(&p0), &cl(&p1)) <= opts.overcut_mm()
             {
                 break;
             }
@@ -789,16 +835,14 @@ fn link_between(
     }
     for w in inner {
         let (cc, n) = pass_point(s, other, w, t)?;
-        moves.push(Move {
-            kind: MoveKind::Link,
-            cc_point: cc,
-            cl_point: cc + n * r,
-            tool_axis: Vector3::z(),
-            patch: patch as u32,
-            line: line as u32,
-        });
         let (u, v) = at(other, w, t);
-        params.push([u, v]);
+        let p = SurfacePoint {
+            patch,
+            uv: [u, v],
+            cc,
+            normal: n,
+        };
+        out.link(&p, line, Footprint::NONE);
     }
     Ok(())
 }

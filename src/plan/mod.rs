@@ -7,12 +7,17 @@
 pub mod air;
 pub mod axis;
 pub mod corners;
+pub mod distance;
+pub mod draft;
 pub mod gouge;
 pub mod isoparametric;
 pub mod options;
 pub mod order;
+pub mod pipeline;
+pub mod reach;
 pub mod stepover;
 pub mod toolpath;
 
 pub use options::PlanOptions;
-pub use toolpath::{Move, MoveKind, PatchRun, PlanReport, Toolpath};
+pub use pipeline::Planned;
+pub use toolpath::{Move, MoveKind, PatchRun, PlanReport, PlanStatus, Problem, Toolpath};

@@ -137,6 +137,13 @@ impl PlanOptions {
         self.flute_length_mm.unwrap_or(4.0 * self.tool_radius_mm)
     }
 
+    /// How deep a straight move may cut into the surface (mm): the chordal tolerance, but
+    /// never more than [`MAX_OVERCUT_MM`], so that plans pass a verification whose gouge
+    /// tolerance is that much.
+    pub fn overcut_mm(&self) -> f64 {
+        self.chordal_mm.min(MAX_OVERCUT_MM)
+    }
+
     /// The shank radius, defaulting to the ball radius (mm).
     pub fn shank_radius(&self) -> f64 {
         self.shank_radius_mm.unwrap_or(self.tool_radius_mm)
@@ -217,6 +224,10 @@ impl PlanOptions {
         Ok(())
     }
 }
+
+/// Deepest a straight move may cut into the surface whatever the chordal tolerance (mm):
+/// two micrometres, the gouge tolerance a plan is verified with (`verify::MAX_GOUGE_TOLERANCE_MM`).
+pub const MAX_OVERCUT_MM: f64 = 0.002;
 
 /// Largest tool-axis tilt from +Z a plan may ask for (degrees): beyond 90° the tool comes
 /// from below the horizontal, as a swivelling table tilted past upright presents a part's

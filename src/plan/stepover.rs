@@ -34,6 +34,19 @@ pub fn side_step(h: f64, r: f64, kappa: f64) -> Result<f64> {
     Ok((8.0 * h * r / denom).sqrt())
 }
 
+/// Largest `r·kappa` (concave) the planner's side step takes at face value: tighter than
+/// that, eq. 5 is read with this value, a smaller step than it would give (where the
+/// surface is tighter than the ball, the ball cannot reach the bottom anyway; that area is
+/// found and reported as rest material).
+pub const MAX_CONCAVE_RK: f64 = 0.75;
+
+/// [`side_step`] with the concave curvature clamped to [`MAX_CONCAVE_RK`]` / r`: never an
+/// error, and never more than twice the flat step.
+pub fn side_step_clamped(h: f64, r: f64, kappa: f64) -> f64 {
+    let k = kappa.min(MAX_CONCAVE_RK / r);
+    (8.0 * h * r / (1.0 - r * k)).sqrt()
+}
+
 /// Scallop height (mm) predicted by eq. 5 for a physical side step `g` (its inverse).
 pub fn predicted_scallop(g: f64, r: f64, kappa: f64) -> f64 {
     g * g * (1.0 - r * kappa) / (8.0 * r)
@@ -106,7 +119,16 @@ mod tests {
     }
 
     #[test]
-    fn too_tight_concavity_is_an_error() {
+    fn too_tight_concavity_is_an_error_or_clamped() {
         assert!(side_step(0.01, 1.0, 1.5).is_err());
+        // Clamped: the step at r·kappa = 0.75, twice the flat one, whatever tighter.
+        let flat = side_step(0.01, 1.0, 0.0).unwrap();
+        for k in [0.75, 1.0, 1.5, 1e6] {
+            assert!((side_step_clamped(0.01, 1.0, k) - 2.0 * flat).abs() < 1e-12);
+        }
+        assert_eq!(
+            side_step_clamped(0.01, 1.0, 0.3),
+            side_step(0.01, 1.0, 0.3).unwrap()
+        );
     }
 }

@@ -115,6 +115,52 @@ pub struct PlanReport {
     pub machining_time_min: f64,
     /// Wall time of planning (ms); filled by the caller, which owns the clock.
     pub plan_ms: f64,
+    /// `planned`, or `planned_with_problems` when anything in `problems` is left undone.
+    pub status: PlanStatus,
+    /// Area of the surface the plan does not machine to the scallop height (mm²): the
+    /// rest area, which another tool or set-up must finish.
+    pub unreachable_area_mm2: f64,
+    /// The rest area's regions, largest first.
+    pub rest: Vec<super::reach::RestRegion>,
+    /// What the plan leaves undone or cannot promise; empty when it is done.
+    pub problems: Vec<Problem>,
+}
+
+/// Whether a plan did everything asked of it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanStatus {
+    #[default]
+    Planned,
+    /// Something is left undone: see the report's problems.
+    PlannedWithProblems,
+}
+
+impl PlanStatus {
+    /// The status a list of problems gives.
+    pub fn of(problems: &[Problem]) -> Self {
+        if problems.is_empty() {
+            PlanStatus::Planned
+        } else {
+            PlanStatus::PlannedWithProblems
+        }
+    }
+}
+
+/// Something a plan leaves undone or cannot promise, with where to look.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Problem {
+    /// What kind: `rest_faces_away`, `rest_tool_hits`, `rest_no_way_out`, `rest_too_tight`,
+    /// `turn_margin`, `scallop`, `gouge`, `unproven`.
+    pub kind: String,
+    /// What it is and what to do about it, for a person.
+    pub message: String,
+    /// How many cut points, moves or samples it concerns.
+    pub count: usize,
+    /// Where it is (mm), if it has one place.
+    pub at_mm: Option<[f64; 3]>,
+    /// A move of the path near it, where a viewer puts the tool.
+    pub near_move: Option<usize>,
 }
 
 /// Rapid traverse rate assumed for time estimates (mm/min).
@@ -192,6 +238,10 @@ impl Toolpath {
             notes: Vec::new(),
             machining_time_min: 0.0,
             plan_ms: 0.0,
+            status: PlanStatus::Planned,
+            unreachable_area_mm2: 0.0,
+            rest: Vec::new(),
+            problems: Vec::new(),
         };
         let mut patches: Vec<u32> = self.moves.iter().map(|m| m.patch).collect();
         patches.sort_unstable();

@@ -47,6 +47,18 @@ impl DiffGeom {
         })
     }
 
+    /// The same point seen from the other side: normal and second fundamental form (and
+    /// so every curvature) change sign.
+    pub fn flipped(self) -> Self {
+        DiffGeom {
+            normal: -self.normal,
+            l: -self.l,
+            m: -self.m,
+            n: -self.n,
+            ..self
+        }
+    }
+
     /// `EG − F²`, the squared area element.
     pub fn metric_det(&self) -> f64 {
         self.e * self.g - self.f * self.f

@@ -7,6 +7,7 @@ use super::capsule::Capsule;
 use super::heatmap::{worse, HeatMap};
 use super::index::CapsuleIndex;
 use super::probe::{Material, Probe};
+use super::rest::RestMask;
 use super::stats::weighted_quantile;
 use super::{CutterPath, PatchVerification, ToolSide, Verification, VerifyOptions};
 use crate::geom::{Aabb, Point3, Vector3};
@@ -49,6 +50,8 @@ struct Sample {
     singular: bool,
     /// `|S_u × S_v|` (mm² per unit parameter²).
     area_density: f64,
+    /// Inside the plan's rest area (left for another tool).
+    rest: bool,
 }
 
 /// Running totals of one band or patch.
@@ -65,7 +68,13 @@ struct Acc {
     reached_area: f64,
     scallop_area: f64,
     max_left: Option<f64>,
+    /// Where `max_left` was measured.
+    max_left_at: Option<Point3>,
     max_gouge: f64,
+    /// Where the deepest gouge was measured.
+    max_gouge_at: Option<Point3>,
+    /// Area inside the plan's rest area (mm²).
+    rest_area: f64,
     upper: Option<f64>,
     /// Extra measurements at located cusps.
     refined: usize,
@@ -88,13 +97,34 @@ impl Acc {
         self.uncut_area += o.uncut_area;
         self.reached_area += o.reached_area;
         self.scallop_area += o.scallop_area;
-        self.max_left = max_opt(self.max_left, o.max_left);
-        self.max_gouge = self.max_gouge.max(o.max_gouge);
+        self.note_left(o.max_left, o.max_left_at);
+        self.note_gouge(o.max_gouge, o.max_gouge_at);
+        self.rest_area += o.rest_area;
         self.upper = max_opt(self.upper, o.upper);
         self.refined += o.refined;
         self.gouge_upper = max_opt(self.gouge_upper, o.gouge_upper);
         self.spacing = self.spacing.max(o.spacing);
         self.values.extend(o.values);
+    }
+}
+
+impl Acc {
+    /// Raises the maximum material left to `left` (at `at`) if it is larger; ties keep the
+    /// first, so that the result does not depend on the order bands finish in.
+    fn note_left(&mut self, left: Option<f64>, at: Option<Point3>) {
+        if let Some(l) = left {
+            if self.max_left.is_none_or(|m| l > m) {
+                self.max_left = Some(l);
+                self.max_left_at = at;
+            }
+        }
+    }
+    /// Raises the deepest gouge to `depth` (at `at`) if it is deeper.
+    fn note_gouge(&mut self, depth: f64, at: Option<Point3>) {
+        if depth > self.max_gouge {
+            self.max_gouge = depth;
+            self.max_gouge_at = at;
+        }
     }
 }
 
@@ -117,6 +147,7 @@ struct Ctx<'a> {
     max_depth: f64,
     sigma: f64,
     opts: &'a VerifyOptions,
+    rest: &'a RestMask,
 }
 
 fn face_size(face: &FaceSurface) -> (f64, f64, f64) {
@@ -184,7 +215,9 @@ fn geometry(face: &FaceSurface, u: f64, v: f64) -> Option<(SurfaceDerivs, DiffGe
     })
 }
 
-fn measure(ctx: &Ctx, probe: &mut Probe, face: &FaceSurface, u: f64, v: f64) -> Sample {
+fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
+    let face = &ctx.surface.faces()[fi];
+    let rest = ctx.rest.contains(fi, u, v);
     let unmeasured = |point: Point3, singular: bool, area_density: f64| Sample {
         corner: Corner {
             point,
@@ -200,6 +233,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, face: &FaceSurface, u: f64, v: f64) -> 
         normal: Vector3::zeros(),
         singular,
         area_density,
+        rest,
     };
     let Some((d, g)) = geometry(face, u, v) else {
         return unmeasured(face.subs(u, v), true, 0.0);
@@ -248,6 +282,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, face: &FaceSurface, u: f64, v: f64) -> 
         normal: g.normal,
         singular: false,
         area_density,
+        rest,
     }
 }
 
@@ -276,7 +311,6 @@ fn band(
     own_first: bool,
     mut heat: Option<&mut HeatMap>,
 ) -> Acc {
-    let face = &ctx.surface.faces()[fi];
     let FaceGrid { nu, nv } = ctx.grids[fi];
     let (du, dv) = (1.0 / (nu - 1) as f64, 1.0 / (nv - 1) as f64);
     let r = ctx.radius;
@@ -293,7 +327,7 @@ fn band(
         let v = at(j, nv);
         row.clear();
         for i in 0..nu {
-            row.push(measure(ctx, probe, face, at(i, nu), v));
+            row.push(measure(ctx, probe, fi, at(i, nu), v));
         }
         if j > j0 || own_first {
             let wv = if j == 0 || j == nv - 1 { 0.5 } else { 1.0 };
@@ -309,6 +343,9 @@ fn band(
                     acc.singular += 1;
                     continue;
                 }
+                if s.rest {
+                    acc.rest_area += w;
+                }
                 if !s.corner.reached {
                     acc.unreached += 1;
                     acc.unreached_area += w;
@@ -316,8 +353,6 @@ fn band(
                     continue;
                 }
                 let left = s.corner.left_mm;
-                acc.reached_area += w;
-                acc.max_left = max_opt(acc.max_left, Some(left));
                 if left > h_req {
                     acc.uncut_area += w;
                 }
@@ -325,10 +360,16 @@ fn band(
                     acc.gouges += 1;
                     acc.gouge_area += w;
                 }
-                acc.max_gouge = acc.max_gouge.max(-left);
+                acc.note_gouge(-left, Some(s.corner.point));
                 if left < 0.0 && deepest.is_none_or(|(d, ..)| left < d) {
                     deepest = Some((left, at(i, nu), v));
                 }
+                if s.rest {
+                    // Left for another tool by the plan: not a scallop.
+                    continue;
+                }
+                acc.reached_area += w;
+                acc.note_left(Some(left), Some(s.corner.point));
                 let scallop = left.max(0.0);
                 acc.scallop_area += scallop * w;
                 values.push((scallop, w));
@@ -360,44 +401,48 @@ fn band(
                     boundary: [j == 1, i + 2 == nu, j + 1 == nv, i == 0],
                 };
                 let b = cell_bound(&c, &frame, r, ctx.reach, best);
+                acc.gouge_upper = max_opt(acc.gouge_upper, Some(b.gouge_upper_mm));
+                if prev[i].rest || prev[i + 1].rest || row[i].rest || row[i + 1].rest {
+                    // Part of the cell is rest area: its material left is not a scallop.
+                    continue;
+                }
                 acc.upper = max_opt(acc.upper, Some(b.scallop_upper_mm));
                 // Measure at the cusp the bound located, where it could raise the maximum.
                 if let Some([x, y]) = b.argmax {
                     if acc.max_left.is_none_or(|m| b.scallop_upper_mm > m) {
                         let (u, v) = ((at(i, nu) + x).min(1.0), (at(j - 1, nv) + y).min(1.0));
-                        let s = measure(ctx, probe, face, u, v);
+                        let s = measure(ctx, probe, fi, u, v);
                         if s.corner.reached {
-                            acc.max_left = max_opt(acc.max_left, Some(s.corner.left_mm));
+                            acc.note_left(Some(s.corner.left_mm), Some(s.corner.point));
                             acc.refined += 1;
                         }
                     }
                 }
-                acc.gouge_upper = max_opt(acc.gouge_upper, Some(b.gouge_upper_mm));
             }
         }
         std::mem::swap(&mut prev, &mut row);
     }
     acc.values.push(values);
     if let Some((_, u, v)) = deepest {
-        let bottom = gouge_bottom(ctx, probe, face, u, v, du, dv);
-        acc.max_gouge = acc.max_gouge.max(-bottom);
+        let (bottom, at) = gouge_bottom(ctx, probe, fi, u, v, du, dv);
+        acc.note_gouge(-bottom, Some(at));
     }
     acc
 }
 
 /// From a gouged sample at `(u, v)`, Newton steps towards the bottom of the gouge (where
 /// the depth's gradient vanishes), measuring at each; the deepest material left found (mm,
-/// negative).
+/// negative) and where.
 fn gouge_bottom(
     ctx: &Ctx,
     probe: &mut Probe,
-    face: &FaceSurface,
+    fi: usize,
     u: f64,
     v: f64,
     du: f64,
     dv: f64,
-) -> f64 {
-    let mut at = (u, v, measure(ctx, probe, face, u, v).corner);
+) -> (f64, Point3) {
+    let mut at = (u, v, measure(ctx, probe, fi, u, v).corner);
     let mut best = at.2.left_mm;
     for _ in 0..GOUGE_NEWTON_STEPS {
         let c = &at.2;
@@ -417,14 +462,14 @@ fn gouge_bottom(
             sv.clamp(-GOUGE_STEP_CELLS * dv, GOUGE_STEP_CELLS * dv),
         );
         let (nu, nv) = ((at.0 + su).clamp(0.0, 1.0), (at.1 + sv).clamp(0.0, 1.0));
-        let next = measure(ctx, probe, face, nu, nv).corner;
+        let next = measure(ctx, probe, fi, nu, nv).corner;
         if !(next.reached && next.left_mm < best) {
             break;
         }
         best = next.left_mm;
         at = (nu, nv, next);
     }
-    best
+    (best, at.2.point)
 }
 
 /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other: the
@@ -578,6 +623,7 @@ fn summarise(patch: u32, grid: [usize; 2], acc: &Acc) -> PatchVerification {
         area_mm2: acc.area,
         sample_spacing_mm: acc.spacing,
         max_scallop_mm: max_scallop,
+        max_scallop_at_mm: acc.max_left_at.map(|p| [p.x, p.y, p.z]),
         mean_scallop_mm: if acc.reached_area > 0.0 {
             acc.scallop_area / acc.reached_area
         } else {
@@ -588,6 +634,11 @@ fn summarise(patch: u32, grid: [usize; 2], acc: &Acc) -> PatchVerification {
         unreached_fraction: frac(acc.unreached_area),
         unreached_samples: acc.unreached,
         max_gouge_mm: acc.max_gouge.max(0.0),
+        max_gouge_at_mm: acc
+            .max_gouge_at
+            .filter(|_| acc.max_gouge > 0.0)
+            .map(|p| [p.x, p.y, p.z]),
+        rest_fraction: frac(acc.rest_area),
         gouge_count: acc.gouges,
         gouge_fraction: frac(acc.gouge_area),
         scallop_error_bound_mm: scallop_bound,
@@ -615,6 +666,7 @@ pub(super) fn run(
     };
     let index = CapsuleIndex::build(&capsules, r, &region, CELL_PER_RADIUS * r);
     let grids = grids(surface, opts.samples);
+    let rest = RestMask::new(&opts.rest_area, grids.len());
     let mut ctx = Ctx {
         surface,
         capsules: &capsules,
@@ -625,6 +677,7 @@ pub(super) fn run(
         max_depth: region.diagonal(),
         sigma: 1.0,
         opts,
+        rest: &rest,
     };
     let mut probe = Probe::new(&capsules, &index, r, reach, ctx.max_depth);
     ctx.sigma = match opts.tool_side {
@@ -675,17 +728,21 @@ pub(super) fn run(
         area_mm2: o.area_mm2,
         sample_spacing_mm: o.sample_spacing_mm,
         max_scallop_mm: o.max_scallop_mm,
+        max_scallop_at_mm: o.max_scallop_at_mm,
         mean_scallop_mm: o.mean_scallop_mm,
         p95_scallop_mm: o.p95_scallop_mm,
         uncut_fraction: o.uncut_fraction,
         unreached_fraction: o.unreached_fraction,
         unreached_samples: o.unreached_samples,
+        rest_fraction: o.rest_fraction,
         max_gouge_mm: o.max_gouge_mm,
+        max_gouge_at_mm: o.max_gouge_at_mm,
         gouge_count: o.gouge_count,
         gouge_fraction: o.gouge_fraction,
         scallop_error_bound_mm: o.scallop_error_bound_mm,
         gouge_error_bound_mm: o.gouge_error_bound_mm,
         error_bound_mm: o.error_bound_mm,
+        error_bound_target_mm: None,
         singular_samples: o.singular_samples,
         cusp_samples: o.cusp_samples,
         patches,

@@ -103,14 +103,15 @@ pub fn read_program(
 
 impl ProgramHeader {
     /// Verification options for the tolerances the program was made for: its scallop, and
-    /// its chordal tolerance as the gouge tolerance; defaults where it says nothing.
+    /// as gouge tolerance its chordal tolerance or 0.002 mm, whichever is smaller
+    /// ([`super::gouge_tolerance_for`]); defaults where it says nothing.
     pub fn options(&self) -> VerifyOptions {
         let mut o = VerifyOptions::default();
         if let Some(h) = self.scallop_mm {
             o.scallop_mm = h;
         }
         if let Some(c) = self.chordal_mm {
-            o.gouge_tolerance_mm = c;
+            o.gouge_tolerance_mm = super::gouge_tolerance_for(c);
         }
         o
     }

@@ -30,9 +30,11 @@ pub mod gcode;
 pub mod heatmap;
 pub mod index;
 pub mod probe;
+pub mod rest;
 pub mod stats;
 
 pub use cutter::{CutterLocation, CutterPath, ToolTip};
+pub use rest::RestRect;
 
 use crate::error::{Error, Result};
 use crate::surface::tessellate::Tessellation;
@@ -70,6 +72,20 @@ pub struct VerifyOptions {
     /// Worker threads (natively; wasm uses one). Default 0: one per available core. The
     /// result does not depend on it.
     pub threads: usize,
+    /// The area the plan leaves for another tool (where its ball cannot reach): measured,
+    /// but kept out of the scallop statistics and counted as `rest_fraction`. Default none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rest_area: Vec<RestRect>,
+}
+
+/// Largest gouge tolerance a plan's verification uses (mm): two micrometres, what a good
+/// finishing machine holds.
+pub const MAX_GOUGE_TOLERANCE_MM: f64 = 0.002;
+
+/// The gouge tolerance for verifying a plan made with chordal tolerance `chordal_mm`: the
+/// smaller of the two, so that a coarse chord shows up as gouges.
+pub fn gouge_tolerance_for(chordal_mm: f64) -> f64 {
+    chordal_mm.min(MAX_GOUGE_TOLERANCE_MM)
 }
 
 impl Default for VerifyOptions {
@@ -80,6 +96,7 @@ impl Default for VerifyOptions {
             gouge_tolerance_mm: 0.0005,
             tool_side: ToolSide::Auto,
             threads: 0,
+            rest_area: Vec::new(),
         }
     }
 }
@@ -108,6 +125,11 @@ impl VerifyOptions {
     /// Sets the number of worker threads (0: one per core).
     pub fn with_threads(mut self, n: usize) -> Self {
         self.threads = n;
+        self
+    }
+    /// Sets the rest area (see [`VerifyOptions::rest_area`]).
+    pub fn with_rest_area(mut self, rects: Vec<RestRect>) -> Self {
+        self.rest_area = rects;
         self
     }
     /// Sets the tool side.
@@ -142,6 +164,17 @@ impl VerifyOptions {
                 ),
             ));
         }
+        for (i, r) in self.rest_area.iter().enumerate() {
+            let [u0, u1, v0, v1] = r.rect;
+            let inside =
+                |a: f64, b: f64| (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b) && a <= b;
+            if !(inside(u0, u1) && inside(v0, v1)) {
+                return Err(Error::param(
+                    "rest_area",
+                    format!("rectangle {i} of face {} is {:?}: it must be [u0, u1, v0, v1] with 0 ≤ u0 ≤ u1 ≤ 1 and 0 ≤ v0 ≤ v1 ≤ 1", r.face, r.rect),
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -158,8 +191,10 @@ pub struct PatchVerification {
     pub area_mm2: f64,
     /// Largest distance between diagonal neighbours of the sample grid (mm).
     pub sample_spacing_mm: f64,
-    /// Largest material left over the samples the tool reached (mm).
+    /// Largest material left over the samples the tool reached, outside the rest area (mm).
     pub max_scallop_mm: f64,
+    /// Where that is (mm), if any sample was reached.
+    pub max_scallop_at_mm: Option<[f64; 3]>,
     /// Area-weighted mean material left over the reached area, gouges counting as 0 (mm).
     pub mean_scallop_mm: f64,
     /// Area-weighted 95th percentile of the same (mm).
@@ -172,6 +207,10 @@ pub struct PatchVerification {
     pub unreached_samples: usize,
     /// Deepest overcut below the surface (mm); 0 if none.
     pub max_gouge_mm: f64,
+    /// Where that is (mm), if anything was overcut.
+    pub max_gouge_at_mm: Option<[f64; 3]>,
+    /// Fraction of the area in the plan's rest area (left for another tool).
+    pub rest_fraction: f64,
     /// Samples overcut deeper than the gouge tolerance.
     pub gouge_count: usize,
     /// Fraction of the area overcut deeper than the gouge tolerance.
@@ -205,17 +244,22 @@ pub struct Verification {
     pub area_mm2: f64,
     pub sample_spacing_mm: f64,
     pub max_scallop_mm: f64,
+    pub max_scallop_at_mm: Option<[f64; 3]>,
     pub mean_scallop_mm: f64,
     pub p95_scallop_mm: f64,
     pub uncut_fraction: f64,
     pub unreached_fraction: f64,
     pub unreached_samples: usize,
+    pub rest_fraction: f64,
     pub max_gouge_mm: f64,
+    pub max_gouge_at_mm: Option<[f64; 3]>,
     pub gouge_count: usize,
     pub gouge_fraction: f64,
     pub scallop_error_bound_mm: f64,
     pub gouge_error_bound_mm: f64,
     pub error_bound_mm: f64,
+    /// The error bound [`verify_to_bound`] aimed for (mm); `None` for a plain run.
+    pub error_bound_target_mm: Option<f64>,
     pub singular_samples: usize,
     pub cusp_samples: usize,
     /// The same per patch.
@@ -239,12 +283,43 @@ const BOUND_SAFETY: f64 = 1.1;
 /// As [`verify`], with as many samples as it takes for `error_bound_mm ≤ target_mm`:
 /// starting from `opts.samples`, the count grows in proportion to the bound's excess (the
 /// bound falls with the square of the spacing, so with the number of samples), for at most
-/// a few rounds; the result says what was reached.
+/// a few rounds; the result says what was reached (`error_bound_target_mm`).
 pub fn verify_to_bound(
     surface: &Surface,
     path: &CutterPath,
     opts: &VerifyOptions,
     target_mm: f64,
+) -> Result<Verification> {
+    bound_rounds(opts, target_mm, MAX_SAMPLES, &mut |o| {
+        verify(surface, path, o)
+    })
+}
+
+/// As [`verify_to_bound`] with at most `max_samples` samples, and the heat map of the last
+/// round (see [`verify_with_heat_map`]).
+pub fn verify_to_bound_with_heat_map(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    target_mm: f64,
+    max_samples: usize,
+    mesh: &Tessellation,
+) -> Result<(Verification, Vec<f32>)> {
+    let mut heat = Vec::new();
+    let v = bound_rounds(opts, target_mm, max_samples, &mut |o| {
+        let (v, h) = verify_with_heat_map(surface, path, o, mesh)?;
+        heat = h;
+        Ok(v)
+    })?;
+    Ok((v, heat))
+}
+
+/// The rounds of [`verify_to_bound`], each run by `run`.
+fn bound_rounds(
+    opts: &VerifyOptions,
+    target_mm: f64,
+    max_samples: usize,
+    run: &mut dyn FnMut(&VerifyOptions) -> Result<Verification>,
 ) -> Result<Verification> {
     if !(target_mm.is_finite() && target_mm > 0.0) {
         return Err(Error::param(
@@ -252,16 +327,18 @@ pub fn verify_to_bound(
             format!("the target bound must be a positive number of mm, got {target_mm}"),
         ));
     }
+    let cap = max_samples.clamp(MIN_SAMPLES, MAX_SAMPLES);
     let mut o = opts.clone();
-    let mut v = verify(surface, path, &o)?;
+    let mut v = run(&o)?;
     for _ in 1..BOUND_ROUNDS {
-        if v.error_bound_mm <= target_mm || o.samples >= MAX_SAMPLES {
+        if v.error_bound_mm <= target_mm || o.samples >= cap {
             break;
         }
         let grow = (v.error_bound_mm / target_mm * BOUND_SAFETY).clamp(1.5, BOUND_MAX_GROWTH);
-        o.samples = ((o.samples as f64 * grow).ceil() as usize).min(MAX_SAMPLES);
-        v = verify(surface, path, &o)?;
+        o.samples = ((o.samples as f64 * grow).ceil() as usize).min(cap);
+        v = run(&o)?;
     }
+    v.error_bound_target_mm = Some(target_mm);
     Ok(v)
 }
 

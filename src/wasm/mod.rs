@@ -10,7 +10,7 @@ use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::{isoparametric, PlanOptions, PlanReport, Toolpath};
 use crate::surface::tessellate::Tessellation;
-use crate::verify::{self, CutterPath, Verification, VerifyOptions};
+use crate::verify::{self, CutterPath, RestRect, Verification, VerifyOptions};
 use wasm_bindgen::prelude::*;
 
 fn js_err(e: Error) -> JsError {
@@ -203,16 +203,20 @@ impl WasmModel {
         let planned = isoparametric::plan(&self.model, &opts, &mut cb).map_err(js_err)?;
         let mut report = planned.report(&opts);
         report.plan_ms = now_ms() - t0;
-        let path = planned.toolpath;
+        let rest_rects = planned.rest_rects(&self.model);
+        let (rest_positions, rest_why) = planned.rest_triangles(&self.model);
         let job = JobInfo {
             model: self.model.name.clone(),
-            strategy: "isoparametric".into(),
+            strategy: planned.strategy.into(),
         };
         Ok(WasmPlan {
-            path,
+            path: planned.toolpath,
             report,
             opts,
             job,
+            rest_rects,
+            rest_positions,
+            rest_why,
         })
     }
 }
@@ -256,6 +260,11 @@ pub struct WasmPlan {
     report: PlanReport,
     opts: PlanOptions,
     job: JobInfo,
+    /// The rest area as face rectangles, for the verification's mask.
+    rest_rects: Vec<RestRect>,
+    /// The rest area as triangles (`x y z` per vertex, mm) and their reasons.
+    rest_positions: Vec<f32>,
+    rest_why: Vec<u8>,
 }
 
 #[wasm_bindgen(js_class = Plan)]
@@ -304,9 +313,35 @@ impl WasmPlan {
         let v: Vec<u32> = self.path.moves.iter().map(|m| m.patch).collect();
         js_sys::Uint32Array::from(&v[..])
     }
-    /// The report: lengths (mm), counts, predicted scallop (mm), time (min), `plan_ms`.
+    /// The report: lengths (mm), counts, predicted scallop (mm), time (min), `plan_ms`,
+    /// `status` (`planned` or `planned_with_problems`), `unreachable_area_mm2`, `rest`
+    /// (regions) and `problems` (each with `kind`, `message`, `at_mm` and `near_move`).
     pub fn report(&self) -> Result<JsValue, JsError> {
         serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))
+    }
+
+    /// The report with what a cutting simulation of this plan found added to its problems
+    /// and status (gouges, scallop over the request, an error bound too wide to prove it).
+    #[wasm_bindgen(js_name = reportWith)]
+    pub fn report_with(&self, verification: &WasmVerification) -> Result<JsValue, JsError> {
+        let mut r = self.report.clone();
+        r.add_verification(&verification.summary);
+        serde_wasm_bindgen::to_value(&r).map_err(|e| JsError::new(&e.to_string()))
+    }
+
+    /// The rest area (what the plan leaves unmachined) as triangles on the surface: `x y z`
+    /// per vertex (mm), three vertices per triangle.
+    #[wasm_bindgen(js_name = restPositions)]
+    pub fn rest_positions(&self) -> js_sys::Float32Array {
+        js_sys::Float32Array::from(&self.rest_positions[..])
+    }
+
+    /// Per triangle of `restPositions`, why it is not machined: 0 the surface faces away
+    /// from every allowed axis, 1 the shank or holder would hit, 2 the surface is tighter
+    /// than the ball, 3 no clear way there through the air.
+    #[wasm_bindgen(js_name = restReasons)]
+    pub fn rest_reasons(&self) -> js_sys::Uint8Array {
+        js_sys::Uint8Array::from(&self.rest_why[..])
     }
     /// The default G-code program, in mm: three-axis (plain dialect) while the tool axis
     /// stays at +Z, else LinuxCNC joint values for the `table-table-ac` machine. Written when
@@ -392,14 +427,37 @@ impl WasmPlan {
     }
 }
 
+/// Default cap on the samples a verification to a bound may grow to (the page's).
+const PAGE_MAX_SAMPLES: usize = 8_000_000;
+
+/// The `bound_mm` and `max_samples` fields of verify options, if given.
+fn bound_options(options: &JsValue) -> Result<(Option<f64>, usize), JsError> {
+    if options.is_undefined() || options.is_null() {
+        return Ok((None, PAGE_MAX_SAMPLES));
+    }
+    let given: serde_json::Value = serde_wasm_bindgen::from_value(options.clone())
+        .map_err(|e| JsError::new(&format!("invalid verify options: {e}")))?;
+    let bound = given.get("bound_mm").and_then(|v| v.as_f64());
+    let max = given
+        .get("max_samples")
+        .and_then(|v| v.as_u64())
+        .map_or(PAGE_MAX_SAMPLES, |v| v as usize);
+    Ok((bound, max))
+}
+
 /// Verification options from a JavaScript object over `base`: any fields of
-/// [`VerifyOptions`] given replace those of `base`.
+/// [`VerifyOptions`] given replace those of `base` (`bound_mm` and `max_samples` are read
+/// by [`bound_options`]).
 fn verify_options(base: VerifyOptions, options: JsValue) -> Result<VerifyOptions, JsError> {
     if options.is_undefined() || options.is_null() {
         return Ok(base);
     }
-    let given: serde_json::Value = serde_wasm_bindgen::from_value(options)
+    let mut given: serde_json::Value = serde_wasm_bindgen::from_value(options)
         .map_err(|e| JsError::new(&format!("invalid verify options: {e}")))?;
+    if let Some(o) = given.as_object_mut() {
+        o.remove("bound_mm");
+        o.remove("max_samples");
+    }
     let mut merged = serde_json::to_value(&base).expect("options serialise");
     match (given, &mut merged) {
         (serde_json::Value::Object(g), serde_json::Value::Object(m)) => {
@@ -419,22 +477,36 @@ impl WasmModel {
     /// `mesh` is the tessellation the page shows (from `tessellate`): the heat map has one
     /// value per vertex of it. `options` is a plain object with any of `samples`,
     /// `scallop_mm`, `gouge_tolerance_mm`, `tool_side` (`"auto"`, `"normal"`, `"opposite"`);
-    /// the scallop and gouge tolerance default to the plan's scallop and chordal tolerance.
+    /// the scallop defaults to the plan's, the gouge tolerance to its chordal tolerance or
+    /// 0.002 mm, whichever is smaller, and the plan's rest area is measured apart. With
+    /// `bound_mm` the sample count grows from `samples` (to at most `max_samples`, default
+    /// 8 000 000) until the error bound is within it.
     pub fn verify(
         &self,
         plan: &WasmPlan,
         mesh: &WasmMesh,
         options: JsValue,
     ) -> Result<WasmVerification, JsError> {
+        let (bound, max_samples) = bound_options(&options)?;
         let base = VerifyOptions::default()
             .with_scallop(plan.opts.scallop_mm)
-            .with_gouge_tolerance(plan.opts.chordal_mm);
+            .with_gouge_tolerance(verify::gouge_tolerance_for(plan.opts.chordal_mm))
+            .with_rest_area(plan.rest_rects.clone());
         let opts = verify_options(base, options)?;
         let path = CutterPath::from_toolpath(&plan.path).map_err(js_err)?;
         let t0 = now_ms();
-        let (summary, heat) =
-            verify::verify_with_heat_map(&self.model.surface, &path, &opts, &mesh.mesh)
-                .map_err(js_err)?;
+        let (summary, heat) = match bound {
+            Some(b) => verify::verify_to_bound_with_heat_map(
+                &self.model.surface,
+                &path,
+                &opts,
+                b,
+                max_samples,
+                &mesh.mesh,
+            ),
+            None => verify::verify_with_heat_map(&self.model.surface, &path, &opts, &mesh.mesh),
+        }
+        .map_err(js_err)?;
         Ok(WasmVerification {
             summary,
             heat,

@@ -1,0 +1,223 @@
+//! What a strategy hands the shared pipeline: the cuts it chose, in order, as moves on the
+//! surface (ball centres a radius along the surface normal, tool axes still +Z), the air
+//! moves between cuts that leave the surface, and the part of its patch each cut point
+//! stands for (its footprint: what is left uncut if the point cannot be cut).
+//!
+//! Owns: building moves from surface points ([`DraftBuilder`]), footprints. Must not:
+//! choose tool axes, route air moves or decide what is reachable (that is
+//! [`super::pipeline`]'s).
+
+use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
+use super::PlanOptions;
+use crate::geom::{Point3, Vector3};
+use crate::model::Model;
+
+/// A rectangle `[u0, u1, v0, v1]` of a layout patch's `(u, v)` square that one cut point
+/// stands for. Links along a patch side, which add no area of their own, have none.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Footprint {
+    pub patch: u32,
+    pub rect: [f64; 4],
+}
+
+impl Footprint {
+    /// No area.
+    pub const NONE: Footprint = Footprint {
+        patch: u32::MAX,
+        rect: [0.0; 4],
+    };
+
+    /// True for a footprint without area.
+    pub fn is_none(&self) -> bool {
+        self.patch == u32::MAX || self.rect[1] <= self.rect[0] || self.rect[3] <= self.rect[2]
+    }
+
+    /// Its area on the surface (mm²), by 2 × 2 Gauss points.
+    pub fn area_mm2(&self, model: &Model) -> f64 {
+        if self.is_none() {
+            return 0.0;
+        }
+        let p = &model.layout.patches[self.patch as usize];
+        let [u0, u1, v0, v1] = self.rect;
+        let g = 0.5 / 3f64.sqrt();
+        let mut a = 0.0;
+        for x in [0.5 - g, 0.5 + g] {
+            for y in [0.5 - g, 0.5 + g] {
+                let d = p.derivs(&model.surface, u0 + x * (u1 - u0), v0 + y * (v1 - v0));
+                a += d.su.cross(&d.sv).norm();
+            }
+        }
+        0.25 * a * (u1 - u0) * (v1 - v0)
+    }
+
+    /// Its area (mm²) by the midpoint rule on `n × n` cells (for large rectangles).
+    pub fn area_mm2_fine(&self, model: &Model, n: usize) -> f64 {
+        if self.is_none() {
+            return 0.0;
+        }
+        let p = &model.layout.patches[self.patch as usize];
+        let [u0, u1, v0, v1] = self.rect;
+        let (du, dv) = ((u1 - u0) / n as f64, (v1 - v0) / n as f64);
+        let mut a = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let d = p.derivs(
+                    &model.surface,
+                    u0 + (i as f64 + 0.5) * du,
+                    v0 + (j as f64 + 0.5) * dv,
+                );
+                a += d.su.cross(&d.sv).norm();
+            }
+        }
+        a * du * dv
+    }
+
+    /// Its middle on the surface (mm).
+    pub fn centre(&self, model: &Model) -> Point3 {
+        let p = &model.layout.patches[self.patch as usize];
+        let [u0, u1, v0, v1] = self.rect;
+        p.subs(&model.surface, 0.5 * (u0 + u1), 0.5 * (v0 + v1))
+    }
+}
+
+/// A point of the surface a strategy wants cut: where on which patch, the contact point and
+/// the unit normal on the tool's side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub patch: u32,
+    pub uv: [f64; 2],
+    pub cc: Point3,
+    pub normal: Vector3,
+}
+
+/// A strategy's cuts, ready for the pipeline.
+#[derive(Debug, Clone)]
+pub struct Draft {
+    /// The strategy's name, as the report and the program header give it.
+    pub strategy: &'static str,
+    /// The moves: cuts on the surface, and the air moves between them (a retract to the
+    /// safe plane, a rapid above the next cut, a plunge onto it).
+    pub toolpath: Toolpath,
+    /// One per move: the patch area it stands for.
+    pub footprints: Vec<Footprint>,
+    /// Height of the safe plane (mm).
+    pub safe_z: f64,
+    /// Retractions the strategy could not avoid.
+    pub forced_retractions: usize,
+}
+
+/// Builds a [`Draft`] move by move.
+pub struct DraftBuilder {
+    r: f64,
+    safe_z: f64,
+    moves: Vec<Move>,
+    params: Vec<[f64; 2]>,
+    footprints: Vec<Footprint>,
+}
+
+impl DraftBuilder {
+    /// An empty draft for `model` planned with `opts`: the safe plane is two tool radii
+    /// and the clearance above the model.
+    pub fn new(model: &Model, opts: &PlanOptions) -> Self {
+        let r = opts.tool_radius_mm;
+        DraftBuilder {
+            r,
+            safe_z: model.surface.bbox().max[2] + 2.0 * r + opts.clearance_mm,
+            moves: Vec::new(),
+            params: Vec::new(),
+            footprints: Vec::new(),
+        }
+    }
+
+    /// Moves so far (the index the next move gets).
+    pub fn len(&self) -> usize {
+        self.moves.len()
+    }
+
+    /// True before the first move.
+    pub fn is_empty(&self) -> bool {
+        self.moves.is_empty()
+    }
+
+    fn push(&mut self, kind: MoveKind, p: &SurfacePoint, line: u32, fp: Footprint) {
+        self.moves.push(Move {
+            kind,
+            cc_point: p.cc,
+            cl_point: p.cc + p.normal * self.r,
+            tool_axis: Vector3::z(),
+            patch: p.patch,
+            line,
+        });
+        self.params.push(p.uv);
+        self.footprints.push(fp);
+    }
+
+    /// A move off the surface, standing at the last move's contact point.
+    fn air(&mut self, kind: MoveKind, cl: Point3) {
+        let Some(last) = self.moves.last().copied() else {
+            return;
+        };
+        self.moves.push(Move {
+            kind,
+            cl_point: cl,
+            ..last
+        });
+        self.params.push(*self.params.last().unwrap_or(&[0.0, 0.0]));
+        self.footprints.push(Footprint::NONE);
+    }
+
+    /// Comes down onto `p` from the safe plane (retracting from the last cut first).
+    pub fn approach(&mut self, p: &SurfacePoint, line: u32, fp: Footprint) {
+        self.retract();
+        let cl = p.cc + p.normal * self.r;
+        self.push(MoveKind::Rapid, p, line, Footprint::NONE);
+        if let Some(m) = self.moves.last_mut() {
+            m.cl_point = Point3::new(cl.x, cl.y, self.safe_z);
+        }
+        self.push(MoveKind::Plunge, p, line, fp);
+    }
+
+    /// Cuts to `p` at the cutting feed.
+    pub fn feed(&mut self, p: &SurfacePoint, line: u32, fp: Footprint) {
+        self.push(MoveKind::Feed, p, line, fp);
+    }
+
+    /// Moves along the surface to `p` between two cuts (a step-over, a patch transit).
+    pub fn link(&mut self, p: &SurfacePoint, line: u32, fp: Footprint) {
+        self.push(MoveKind::Link, p, line, fp);
+    }
+
+    /// Leaves the surface straight up to the safe plane, if on it.
+    pub fn retract(&mut self) {
+        if let Some(last) = self.moves.last().copied() {
+            if last.kind.on_surface() {
+                let up = Point3::new(last.cl_point.x, last.cl_point.y, self.safe_z);
+                self.air(MoveKind::Retract, up);
+            }
+        }
+    }
+
+    /// The draft: a last retract, and the path with its patch runs and predicted scallop.
+    pub fn finish(
+        mut self,
+        strategy: &'static str,
+        runs: Vec<PatchRun>,
+        max_predicted_scallop_mm: f64,
+        forced_retractions: usize,
+    ) -> Draft {
+        self.retract();
+        Draft {
+            strategy,
+            toolpath: Toolpath {
+                tool_radius_mm: self.r,
+                moves: self.moves,
+                max_predicted_scallop_mm,
+                runs,
+                params: self.params,
+            },
+            footprints: self.footprints,
+            safe_z: self.safe_z,
+            forced_retractions,
+        }
+    }
+}

@@ -1,0 +1,396 @@
+//! The shared half of planning: from a strategy's [`Draft`] (what to cut, in order) to a
+//! tool path a machine can run, and its report. Every strategy ends here, so every plan
+//! gets the same tool axes, crease lifting, turn checks, air moves, rest area and problems.
+//!
+//! Steps: CL points whose ball cuts into the surface are lifted clear ([`super::gouge`]);
+//! tool axes are chosen ([`super::axis`]); points no allowed axis can cut are left out and
+//! the cuts split there ([`super::reach`]); retracts and approaches are routed around the
+//! model, leaving out cut points the ball cannot get to or away from ([`super::air`]);
+//! turns of the axis between cut points are split where the shank or holder would touch;
+//! what is left undone becomes the rest area and the report's problems.
+//!
+//! Owns: the order of those steps and the report's notes and problems. Must not: decide
+//! what to cut (the strategies do) or measure the result (that is `verify`'s).
+
+use super::air::{self, AirStats, Routed};
+use super::axis::{self, AxisStats, Clearance};
+use super::distance::SurfaceDistance;
+use super::draft::Draft;
+use super::gouge::{self, GougeStats};
+use super::reach::{self, Rest, Why};
+use super::toolpath::{PlanReport, PlanStatus, Problem, Toolpath};
+use super::PlanOptions;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::verify::{RestRect, Verification};
+
+/// Share of the overcut limit by which a ball may cut into the surface at a CL point before
+/// the point is lifted (the rest is left to the straight moves between points).
+const GOUGE_LIFT_SHARE: f64 = 0.2;
+/// Tolerance of the tessellation the air moves are checked against, as a share of the tool
+/// radius (at least the overcut allowed): air moves that do not go straight up lead off
+/// the surface by about twice this first ([`super::air`]).
+const AIR_TESSELLATION_SHARE: f64 = 0.04;
+/// Rounds of leaving out cut points whose retract or approach finds no clear way, before
+/// the plan gives up.
+const MAX_ROUTE_ROUNDS: usize = 64;
+
+/// A planned path with what the planning found.
+#[derive(Debug, Clone)]
+pub struct Planned {
+    /// The strategy that chose the cuts.
+    pub strategy: &'static str,
+    pub toolpath: Toolpath,
+    /// Retractions the strategy could not avoid.
+    pub forced_retractions: usize,
+    /// What the tool-axis assignment found.
+    pub axes: AxisStats,
+    /// CL points lifted where the ball cut into the surface (a crease, a tight concave).
+    pub gouge: GougeStats,
+    /// How retracts and approaches were routed.
+    pub air: AirStats,
+    /// What is not machined, and why.
+    pub rest: Rest,
+    /// Share of the model's area the rest area is (0 to 1).
+    pub rest_fraction: f64,
+}
+
+/// Runs the pipeline on `draft`. `progress` receives the fraction of this part done and
+/// returns `false` to cancel.
+pub fn finish(
+    model: &Model,
+    mut draft: Draft,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<Planned> {
+    let r = opts.tool_radius_mm;
+    let n = draft.toolpath.moves.len();
+    // 1. Balls that cut into the surface away from their contact point are lifted clear;
+    //    what they then leave at the contact point is measured.
+    let mut left = vec![0.0; n];
+    let gouge = if gouge::needed(model, r) {
+        gouge::lift(
+            &model.surface,
+            &mut draft.toolpath,
+            r,
+            GOUGE_LIFT_SHARE * opts.overcut_mm(),
+            &mut left,
+            &mut || progress(0.1),
+        )?
+    } else {
+        GougeStats::default()
+    };
+    if !progress(0.15) {
+        return Err(Error::Cancelled);
+    }
+    // 2. Tool axes; points no allowed axis can cut are left out.
+    let obs = Clearance::new(model, opts);
+    if !progress(0.3) {
+        return Err(Error::Cancelled);
+    }
+    let (mut axes, mut why) = axis::choose(&obs, &mut draft.toolpath, opts, &mut |f| {
+        progress(0.3 + 0.5 * f)
+    })?;
+    // 3. Split the cuts there and route the air moves; where the ball cannot get to a cut or
+    //    away from it, leave those points out too and split again.
+    let dist = SurfaceDistance::new(model, (AIR_TESSELLATION_SHARE * r).max(opts.overcut_mm()));
+    let mut rounds = 0;
+    let (mut path, air) = loop {
+        let (mut path, origin) = reach::split(&draft, &why);
+        axis::fill_air_axes(&mut path);
+        match air::route(model, &mut path, opts, &dist) {
+            Routed::Done(stats) => break (path, stats),
+            Routed::LeaveOut(cuts) => {
+                rounds += 1;
+                if rounds > MAX_ROUTE_ROUNDS {
+                    let p = path.moves[cuts[0]].cl_point;
+                    return Err(Error::Degenerate {
+                        location: format!(
+                            "ball centre ({:.3}, {:.3}, {:.3}) mm",
+                            p.x, p.y, p.z
+                        ),
+                        message: "no clear way for the ball from the safe plane to the cut or back was found by leaving cut points out".into(),
+                    });
+                }
+                for k in cuts {
+                    if let Some(&o) = origin.get(k).filter(|&&o| o != u32::MAX) {
+                        why[o as usize] = Some(Why::NoWayOut);
+                    }
+                }
+            }
+        }
+    };
+    if !progress(0.85) {
+        return Err(Error::Cancelled);
+    }
+    // 4. Turns of the axis between cut points, checked for the shank and holder.
+    axis::bridge_turns(&mut path, &obs, opts, &mut axes);
+    // 5. The rest area: points left out, and points kept whose lifted ball leaves more than
+    //    the scallop at their contact point.
+    let footprints = (0..n)
+        .filter_map(|i| {
+            let w = why[i].or((left[i] > opts.scallop_mm).then_some(Why::TooTight))?;
+            Some((draft.footprints[i], w))
+        })
+        .collect();
+    let rest = reach::rest(model, footprints, &path);
+    let area = model_area(model);
+    progress(1.0);
+    Ok(Planned {
+        strategy: draft.strategy,
+        toolpath: path,
+        forced_retractions: draft.forced_retractions,
+        axes,
+        gouge,
+        air,
+        rest_fraction: if area > 0.0 {
+            (rest.area_mm2 / area).min(1.0)
+        } else {
+            0.0
+        },
+        rest,
+    })
+}
+
+/// Samples per side of a patch for its area.
+const AREA_SAMPLES: usize = 24;
+
+/// The model's area (mm²), from its patches.
+fn model_area(model: &Model) -> f64 {
+    (0..model.layout.len())
+        .map(|p| {
+            super::draft::Footprint {
+                patch: p as u32,
+                rect: [0.0, 1.0, 0.0, 1.0],
+            }
+            .area_mm2_fine(model, AREA_SAMPLES)
+        })
+        .sum()
+}
+
+/// Largest patch-parameter extent of one drawn cell of the rest area.
+const REST_CELL: f64 = 1.0 / 16.0;
+/// Most cells per side of one footprint when drawn.
+const REST_CELLS_MAX: usize = 8;
+
+impl Planned {
+    /// The rest area as rectangles of the surface's faces, for the verification's mask.
+    pub fn rest_rects(&self, model: &Model) -> Vec<RestRect> {
+        let mut out = Vec::new();
+        for (f, _) in &self.rest.footprints {
+            let patch = &model.layout.patches[f.patch as usize];
+            for (face, rect) in patch.face_rects(&model.surface, f.rect) {
+                out.push(RestRect { face, rect });
+            }
+        }
+        out
+    }
+
+    /// The rest area as triangles on the surface, for drawing: `x y z` per vertex (mm),
+    /// three vertices per triangle, and per triangle the reason (the [`Why`] in declaration
+    /// order, 0 to 3).
+    pub fn rest_triangles(&self, model: &Model) -> (Vec<f32>, Vec<u8>) {
+        let mut pos = Vec::new();
+        let mut why = Vec::new();
+        for (f, w) in &self.rest.footprints {
+            let patch = &model.layout.patches[f.patch as usize];
+            let [u0, u1, v0, v1] = f.rect;
+            let cells = |d: f64| ((d / REST_CELL).ceil() as usize).clamp(1, REST_CELLS_MAX);
+            let (nu, nv) = (cells(u1 - u0), cells(v1 - v0));
+            let at = |i: usize, j: usize| {
+                let p = patch.subs(
+                    &model.surface,
+                    u0 + (u1 - u0) * i as f64 / nu as f64,
+                    v0 + (v1 - v0) * j as f64 / nv as f64,
+                );
+                [p.x as f32, p.y as f32, p.z as f32]
+            };
+            for j in 0..nv {
+                for i in 0..nu {
+                    let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                    for tri in [[a, b, c], [a, c, d]] {
+                        for p in tri {
+                            pos.extend_from_slice(&p);
+                        }
+                        why.push(*w as u8);
+                    }
+                }
+            }
+        }
+        (pos, why)
+    }
+
+    /// The report: the path's lengths and counts, notes, the rest area and the problems.
+    pub fn report(&self, opts: &PlanOptions) -> PlanReport {
+        let mut r = self
+            .toolpath
+            .report(self.strategy, opts.feed_mm_min, opts.plunge_feed_mm_min);
+        if self.forced_retractions > 0 {
+            r.notes.push(format!(
+                "no patch order and transit corners avoid retractions on this layout: {} retraction(s) used",
+                self.forced_retractions
+            ));
+        }
+        if let Some(p) = self.gouge.worst_at {
+            r.notes.push(format!(
+                "at {} points the ball, placed by its own face's normal, cut into the surface elsewhere (a crease, or a concave radius below the ball's) by up to {:.4} mm, the deepest at ball centre ({:.3}, {:.3}, {:.3}) mm: they were lifted to touch it without cutting in",
+                self.gouge.lifted, self.gouge.worst_mm, p.x, p.y, p.z
+            ));
+        }
+        if self.axes.tilted > 0 {
+            r.notes.push(format!(
+                "the tool axis tilts away from +Z at {} points to keep the shank and holder clear",
+                self.axes.tilted
+            ));
+        }
+        if self.axes.bridged > 0 {
+            r.notes.push(format!(
+                "at {} moves the tool axis turns in smaller steps through added cut points, so that the shank and holder stay clear while it turns",
+                self.axes.bridged
+            ));
+        }
+        if self.air.escaped > 0 {
+            r.notes.push(format!(
+                "{} retract(s) or approach(es) back away from the surface (along the tool axis or the surface normal) before rising, to keep the ball out of the model",
+                self.air.escaped
+            ));
+        }
+        // What is left undone.
+        r.unreachable_area_mm2 = self.rest.area_mm2;
+        r.rest = self.rest.regions.clone();
+        for why in [Why::FacesAway, Why::ToolHits, Why::NoWayOut, Why::TooTight] {
+            let regions: Vec<&reach::RestRegion> =
+                self.rest.regions.iter().filter(|g| g.why == why).collect();
+            let Some(largest) = regions.first() else {
+                continue;
+            };
+            let area: f64 = regions.iter().map(|g| g.area_mm2).sum();
+            let points: usize = regions.iter().map(|g| g.points).sum();
+            let advice = match why {
+                Why::FacesAway => "use a five-axis machine or allow more tilt (a table tilting past upright reaches undersides)",
+                Why::ToolHits => "use a longer shank or a smaller holder, or allow more tilt",
+                Why::NoWayOut => "allow more tilt, or machine this area in another set-up",
+                Why::TooTight => "finish it with a smaller ball (see the model's smallest concave radius)",
+            };
+            let c = largest.centre_mm;
+            let what = if why == Why::TooTight {
+                "left with more than the scallop height"
+            } else {
+                "not machined"
+            };
+            r.problems.push(Problem {
+                kind: format!("rest_{}", serde_json::to_value(why).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()),
+                message: format!(
+                    "{area:.2} mm² of the surface ({points} cut points, {} region(s); the largest {:.2} mm² around ({:.2}, {:.2}, {:.2}) mm on patch {}) {what}: {}; {advice}",
+                    regions.len(),
+                    largest.area_mm2,
+                    c[0],
+                    c[1],
+                    c[2],
+                    largest.patch,
+                    why.phrase()
+                ),
+                count: points,
+                at_mm: Some(c),
+                near_move: largest.near_move,
+            });
+        }
+        if self.gouge.residual > 0 {
+            r.problems.push(Problem {
+                kind: "gouge".into(),
+                message: format!(
+                    "{} cut points stay up to {:.4} mm inside the surface after lifting",
+                    self.gouge.residual, self.gouge.residual_mm
+                ),
+                count: self.gouge.residual,
+                at_mm: None,
+                near_move: None,
+            });
+        }
+        if let Some(p) = self.axes.first_sweep_hit {
+            let near = self.toolpath.moves.iter().position(|m| m.cl_point == p);
+            r.problems.push(Problem {
+                kind: "turn_margin".into(),
+                message: format!(
+                    "at {} moves the shank or holder comes within the {:.2} mm safety margin of the model (and may touch it) while the tool axis turns between two cut points, the first ending at ball centre ({:.3}, {:.3}, {:.3}) mm: allow more tilt, use a longer shank or a smaller holder",
+                    self.axes.sweep_hits, self.axes.margin_mm, p.x, p.y, p.z
+                ),
+                count: self.axes.sweep_hits,
+                at_mm: Some([p.x, p.y, p.z]),
+                near_move: near,
+            });
+        }
+        if r.max_predicted_scallop_mm > opts.scallop_mm * (1.0 + SCALLOP_SLACK) {
+            r.problems.push(Problem {
+                kind: "scallop".into(),
+                message: format!(
+                    "the passes leave cusps up to {:.4} mm (predicted), above the requested {} mm",
+                    r.max_predicted_scallop_mm, opts.scallop_mm
+                ),
+                count: 1,
+                at_mm: None,
+                near_move: None,
+            });
+        }
+        r.status = PlanStatus::of(&r.problems);
+        r
+    }
+}
+
+/// Relative slack on the scallop comparison (rounding).
+const SCALLOP_SLACK: f64 = 1e-9;
+
+impl PlanReport {
+    /// Adds what a cutting simulation of this plan found wrong to the problems (gouges,
+    /// material above the requested scallop outside the rest area, an error bound too wide
+    /// to prove the scallop) and updates the status.
+    pub fn add_verification(&mut self, v: &Verification) {
+        let h = v.requested_scallop_mm;
+        let at = |p: Option<[f64; 3]>| {
+            p.map(|c| format!(" at ({:.3}, {:.3}, {:.3}) mm", c[0], c[1], c[2]))
+                .unwrap_or_default()
+        };
+        if v.gouge_count > 0 {
+            self.problems.push(Problem {
+                kind: "gouge".into(),
+                message: format!(
+                    "the simulated cut goes up to {:.4} mm into the surface{} ({} samples deeper than the {} mm gouge tolerance)",
+                    v.max_gouge_mm,
+                    at(v.max_gouge_at_mm),
+                    v.gouge_count,
+                    v.gouge_tolerance_mm
+                ),
+                count: v.gouge_count,
+                at_mm: v.max_gouge_at_mm,
+                near_move: None,
+            });
+        }
+        if v.max_scallop_mm > h * (1.0 + SCALLOP_SLACK) {
+            self.problems.push(Problem {
+                kind: "scallop".into(),
+                message: format!(
+                    "the simulated cut leaves up to {:.4} mm{} outside the rest area, above the requested scallop {} mm",
+                    v.max_scallop_mm,
+                    at(v.max_scallop_at_mm),
+                    h
+                ),
+                count: 1,
+                at_mm: v.max_scallop_at_mm,
+                near_move: None,
+            });
+        }
+        if let Some(target) = v.error_bound_target_mm.filter(|&t| v.error_bound_mm > t) {
+            self.problems.push(Problem {
+                kind: "unproven".into(),
+                message: format!(
+                    "the simulation's error bound {:.4} mm is above the {:.4} mm (a quarter of the scallop) it aimed for with {} samples: the scallop and gouges are measured, not proven; simulate with more samples",
+                    v.error_bound_mm, target, v.samples
+                ),
+                count: 1,
+                at_mm: None,
+                near_move: None,
+            });
+        }
+        self.status = PlanStatus::of(&self.problems);
+    }
+}
