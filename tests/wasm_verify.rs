@@ -82,7 +82,10 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     assert!(get(&bs, "samples").as_f64().unwrap() > 20_000.0);
     assert_eq!(get(&bs, "error_bound_target_mm").as_f64(), Some(0.0125));
     let report = plan.report_with(&b).unwrap();
-    assert_eq!(get(&report, "status").as_string().as_deref(), Some("planned"));
+    assert_eq!(
+        get(&report, "status").as_string().as_deref(),
+        Some("planned")
+    );
 
     let bad = js_sys::Object::new();
     js_sys::Reflect::set(&bad, &"samples".into(), &2.into()).unwrap();
