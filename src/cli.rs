@@ -17,7 +17,11 @@ const USAGE: &str = "usage:
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
-              [-o OUT.nc] [--report REPORT.json] [--verify [--verify-samples N]]
+              [-o OUT.nc] [--report REPORT.json]
+              [--verify [--verify-samples N] [--verify-max-samples N]]
+              --verify simulates the cut, from N samples (default 1 000 000) up to at most
+              --verify-max-samples (default 8 000 000) until its error bound is a quarter of
+              the scallop
               exits with 3 after writing its outputs when the plan has problems (rest area,
               gouges, scallop over the request, an unproven simulation), listed on stderr
   tspath machine --list
@@ -238,6 +242,7 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
             "-o",
             "--report",
             "--verify-samples",
+            "--verify-max-samples",
             "--machine",
             "--dialect",
             "--units",
@@ -338,12 +343,16 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
         if let Some(n) = a.count("--verify-samples")? {
             vopts = vopts.with_samples(n);
         }
+        let cap = a
+            .count("--verify-max-samples")?
+            .unwrap_or(verify::PLAN_VERIFY_MAX_SAMPLES);
         // Enough samples for the bound to prove the scallop: a quarter of it.
-        let v = verify::verify_to_bound(
+        let v = verify::verify_to_bound_within(
             &m.surface,
             &CutterPath::from_toolpath(&path)?,
             &vopts,
             VERIFY_BOUND_SHARE * opts.scallop_mm,
+            cap,
         )?;
         report.add_verification(&v);
         Some(v)

@@ -105,6 +105,10 @@ impl Default for VerifyOptions {
 const MIN_SAMPLES: usize = 16;
 /// Each sample keeps 16 bytes for the percentile: 50 million need 800 MB.
 const MAX_SAMPLES: usize = 50_000_000;
+/// Most samples a plan's verification grows to while aiming for its error bound, unless
+/// told otherwise: the same for the CLI's `plan --verify` and the page, so both measure a
+/// plan alike (8 M samples: about 40 s in a browser tab, 130 MB).
+pub const PLAN_VERIFY_MAX_SAMPLES: usize = 8_000_000;
 
 impl VerifyOptions {
     /// Sets the number of samples.
@@ -290,7 +294,18 @@ pub fn verify_to_bound(
     opts: &VerifyOptions,
     target_mm: f64,
 ) -> Result<Verification> {
-    bound_rounds(opts, target_mm, MAX_SAMPLES, &mut |o| {
+    verify_to_bound_within(surface, path, opts, target_mm, MAX_SAMPLES)
+}
+
+/// As [`verify_to_bound`] with at most `max_samples` samples.
+pub fn verify_to_bound_within(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    target_mm: f64,
+    max_samples: usize,
+) -> Result<Verification> {
+    bound_rounds(opts, target_mm, max_samples, &mut |o| {
         verify(surface, path, o)
     })
 }

@@ -427,13 +427,11 @@ impl WasmPlan {
     }
 }
 
-/// Default cap on the samples a verification to a bound may grow to (the page's).
-const PAGE_MAX_SAMPLES: usize = 8_000_000;
 
 /// The `bound_mm` and `max_samples` fields of verify options, if given.
 fn bound_options(options: &JsValue) -> Result<(Option<f64>, usize), JsError> {
     if options.is_undefined() || options.is_null() {
-        return Ok((None, PAGE_MAX_SAMPLES));
+        return Ok((None, verify::PLAN_VERIFY_MAX_SAMPLES));
     }
     let given: serde_json::Value = serde_wasm_bindgen::from_value(options.clone())
         .map_err(|e| JsError::new(&format!("invalid verify options: {e}")))?;
@@ -441,7 +439,7 @@ fn bound_options(options: &JsValue) -> Result<(Option<f64>, usize), JsError> {
     let max = given
         .get("max_samples")
         .and_then(|v| v.as_u64())
-        .map_or(PAGE_MAX_SAMPLES, |v| v as usize);
+        .map_or(verify::PLAN_VERIFY_MAX_SAMPLES, |v| v as usize);
     Ok((bound, max))
 }
 
