@@ -3,7 +3,7 @@
 // Prints the URL it serves on; --port 0 picks a free port.
 import { createServer } from 'node:http';
 import { readFile, stat } from 'node:fs/promises';
-import { extname, join, normalize, resolve, sep } from 'node:path';
+import { basename, extname, join, normalize, resolve, sep } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const here = fileURLToPath(new URL('.', import.meta.url));
@@ -29,7 +29,10 @@ const TYPES = {
   '.tsm': 'text/plain; charset=utf-8',
   '.obj': 'text/plain; charset=utf-8',
   '.ts': 'text/plain; charset=utf-8',
+  '.md': 'text/plain; charset=utf-8',
 };
+/** Licence texts without an extension of their own (`LICENSE.LGPL-3.0`), shown as text. */
+const TEXT_NAMES = /^(LICENSE|COPYING)(\.|$)/;
 
 export function startServer(listenPort = port, listenHost = host) {
   const server = createServer(async (req, res) => {
@@ -46,7 +49,8 @@ export function startServer(listenPort = port, listenHost = host) {
       if (!info.isFile()) throw new Error('not a file');
       const body = await readFile(file);
       res.writeHead(200, {
-        'Content-Type': TYPES[extname(file)] || 'application/octet-stream',
+        'Content-Type': TYPES[extname(file)]
+          || (TEXT_NAMES.test(basename(file)) ? 'text/plain; charset=utf-8' : 'application/octet-stream'),
         'Cache-Control': 'no-store',
       });
       res.end(body);

@@ -278,3 +278,112 @@ fn a_plan_stands_without_its_default_program() {
         .unwrap()
         .contains("TRAORI"));
 }
+
+/// Area of the triangles `x y z` × 3 per triangle (mm²), per reason code.
+fn triangle_areas(positions: &[f32], reasons: &[u8]) -> [f64; 4] {
+    let mut by = [0.0; 4];
+    for (t, &why) in reasons.iter().enumerate() {
+        let p = |k: usize| -> [f64; 3] {
+            let i = 9 * t + 3 * k;
+            [
+                positions[i] as f64,
+                positions[i + 1] as f64,
+                positions[i + 2] as f64,
+            ]
+        };
+        let (a, b, c) = (p(0), p(1), p(2));
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        by[why as usize] += (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0;
+    }
+    by
+}
+
+#[wasm_bindgen_test]
+fn rest_area_reaches_javascript_as_the_report_says() {
+    // What the page draws and lists: a 1.5 mm ball is too big for the concave keycap's
+    // floor fillets (its smallest concave radius is about 0.79 mm).
+    let model = Model::sample("keycap-concave").unwrap();
+    let summary = model.summary().unwrap();
+    let concave = get(&summary, "smallest_concave_radius");
+    let radius = get(&concave, "radius_mm").as_f64().unwrap();
+    assert!(
+        radius > 0.5 && radius < 1.5,
+        "smallest concave radius {radius} mm"
+    );
+    assert_eq!(js_sys::Array::from(&get(&concave, "at_mm")).length(), 3);
+    // Nothing concave: null (as in the CLI's JSON), not a number.
+    let head = Model::sample("head").unwrap().summary().unwrap();
+    assert!(get(&head, "smallest_concave_radius").is_null());
+
+    let options = js_sys::Object::new();
+    js_sys::Reflect::set(&options, &"tool_radius_mm".into(), &1.5.into()).unwrap();
+    js_sys::Reflect::set(&options, &"scallop_mm".into(), &0.05.into()).unwrap();
+    let plan = model.plan(options.into(), None).unwrap();
+    let report = plan.report().unwrap();
+    assert_eq!(
+        get(&report, "status").as_string().as_deref(),
+        Some("planned_with_problems")
+    );
+    let moves = plan.move_kinds().length() as f64;
+    let problems = js_sys::Array::from(&get(&report, "problems"));
+    assert!(problems.length() > 0);
+    let mut tight = false;
+    for p in problems.iter() {
+        let kind = get(&p, "kind").as_string().unwrap();
+        tight |= kind == "rest_too_tight";
+        assert!(
+            get(&p, "message").as_string().unwrap().contains("mm²") || !kind.starts_with("rest_")
+        );
+        let near = get(&p, "near_move");
+        assert!(
+            near.is_null() || near.as_f64().unwrap() < moves,
+            "{kind}: near move {near:?} of {moves}"
+        );
+    }
+    assert!(tight, "the fillets are tighter than the ball");
+
+    // The triangles cover the rest regions: per reason and in all, the areas agree.
+    let positions = plan.rest_positions().to_vec();
+    let reasons = plan.rest_reasons().to_vec();
+    assert_eq!(positions.len(), 9 * reasons.len());
+    assert!(reasons.iter().all(|&w| w < 4));
+    let drawn = triangle_areas(&positions, &reasons);
+    let names = ["faces_away", "tool_hits", "too_tight", "no_way_out"];
+    let mut listed = [0.0; 4];
+    for g in js_sys::Array::from(&get(&report, "rest")).iter() {
+        let why = get(&g, "why").as_string().unwrap();
+        let k = names
+            .iter()
+            .position(|n| *n == why)
+            .expect("a known reason");
+        listed[k] += get(&g, "area_mm2").as_f64().unwrap();
+    }
+    let total = get(&report, "unreachable_area_mm2").as_f64().unwrap();
+    assert!((listed.iter().sum::<f64>() - total).abs() < 1e-9 * total.max(1.0));
+    for k in 0..4 {
+        assert!(
+            (drawn[k] - listed[k]).abs() <= 0.05 * listed[k] + 1e-6,
+            "{}: triangles {} mm², regions {} mm²",
+            names[k],
+            drawn[k],
+            listed[k]
+        );
+    }
+    assert!(listed[2] > 1.0, "too tight: {} mm²", listed[2]);
+}
+
+#[wasm_bindgen_test]
+fn the_simulation_cap_is_the_clis() {
+    // The page's default for `max_samples` is read from here; `plan --verify` uses the same.
+    assert_eq!(
+        tspath::wasm::plan_verify_max_samples(),
+        tspath::verify::PLAN_VERIFY_MAX_SAMPLES as f64
+    );
+    assert_eq!(tspath::wasm::plan_verify_max_samples(), 8_000_000.0);
+}

@@ -44,3 +44,12 @@ export function heatColour(v, scallopMm) {
 }
 
 export const hexCss = (c) => `#${c.toString(16).padStart(6, '0')}`;
+
+/** Why part of the surface is left as rest area, in the order of `Plan.restReasons()`
+ * (0–3) and with the name the report's rest regions use (`why`). */
+export const REST_REASONS = [
+  { why: 'faces_away', label: 'faces away from the tool', colour: 0x5b2a86 },
+  { why: 'tool_hits', label: 'shank or holder would hit', colour: 0xe07b00 },
+  { why: 'too_tight', label: 'tighter than the ball', colour: 0xc2185b },
+  { why: 'no_way_out', label: 'no way in or out', colour: 0x00897b },
+];

@@ -19,6 +19,7 @@ export async function engineInfo() {
     samples: w.sampleNames(),
     machines: w.machineNames().map((name) => ({ name, json: w.machineJson(name) })),
     dialects: w.dialectNames(),
+    verifyMaxSamples: w.planVerifyMaxSamples(),
   };
 }
 

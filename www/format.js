@@ -20,3 +20,28 @@ export function bytes(n) {
   if (n < 1048576) return `${(n / 1024).toFixed(1)} KB`;
   return `${(n / 1048576).toFixed(1)} MB`;
 }
+
+/** Decimals that show `x` to about two significant digits, and at least `least`. */
+function decimalsFor(x, least) {
+  if (!(Math.abs(x) > 0)) return least;
+  return Math.min(8, Math.max(least, 1 - Math.floor(Math.log10(Math.abs(x)))));
+}
+
+/** A small or large length with about two significant digits: `0.0016 mm`, `12.50 mm`. */
+export const mmSig = (x) => (Number.isFinite(x) ? `${x.toFixed(decimalsFor(x, 2))} mm` : '—');
+
+/** An area: `0.265 mm²`, `8924.90 mm²`, `0 mm²`. */
+export function area(x) {
+  if (!Number.isFinite(x)) return '—';
+  if (x === 0) return '0 mm²';
+  return `${x.toFixed(Math.abs(x) >= 1 ? 2 : decimalsFor(x, 2) + 1)} mm²`;
+}
+
+/** A share of a whole as a percentage, never rounded to a misleading 0: `0.06 %`, `< 0.01 %`. */
+export function share(part, whole) {
+  if (!(Number.isFinite(part) && whole > 0)) return '—';
+  const x = part / whole;
+  if (x === 0) return '0 %';
+  if (x < 1e-4) return '< 0.01 %';
+  return pct(x);
+}

@@ -36,7 +36,11 @@ export const PARAMS = [
   { key: 'dialect', field: null, group: 'output', label: 'G-code dialect', kind: 'choice', choices: [], default: 'linuxcnc' },
   { key: 'units', field: null, group: 'output', label: 'Program units', kind: 'choice', choices: [['mm', 'millimetres (G21)'], ['inch', 'inches (G20)']], default: 'mm' },
   // Simulation
-  { key: 'samples', field: null, group: 'sim', label: 'Simulation samples', unit: 'points', kind: 'number', min: 10000, max: 20000000, step: 10000, default: 1000000, integer: true },
+  // As `tspath plan --verify --verify-samples N --verify-max-samples M`: the simulation
+  // starts at `samples` and grows until its error bound is a quarter of the scallop, or
+  // until `max-samples`.
+  { key: 'samples', field: null, group: 'sim', label: 'Simulation samples to start with', unit: 'points', kind: 'number', min: 10000, max: 20000000, step: 10000, default: 1000000, integer: true },
+  { key: 'max-samples', field: null, group: 'sim', label: 'Most simulation samples (grown to prove the scallop)', unit: 'points', kind: 'number', min: 10000, max: 50000000, step: 100000, default: 8000000, integer: true },
 ];
 
 export const GROUPS = [

@@ -9,11 +9,13 @@
 // loaded) and `sync-url` (read the parameters from the page's URL and keep it up to date, so a
 // link reproduces the plan). The engine runs in a Web Worker (worker.js, through client.js);
 // this thread only draws and answers the user. The host's `data-state` says where it is:
-// starting, loading, model-loaded, planning, planned or error; `data-verify` says whether
-// the cutting simulation is running, done or failed.
+// starting, loading, model-loaded, planning, planned or error; `data-status` what the shown
+// plan's report says (`planned`, or `planned_with_problems` when it leaves something undone);
+// `data-verify` whether the cutting simulation is running, done or failed; `data-stale`
+// that the parameters no longer match the plan shown (its downloads are off).
 import { CancelledError, EngineClient } from './client.js';
-import { KINDS, PATCH_COLOURS, heatColour, hexCss, pathColour } from './colours.js';
-import { bytes, deg, int, minutes, mm, ms, pct } from './format.js';
+import { KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour } from './colours.js';
+import { area, bytes, deg, int, minutes, mm, mmSig, ms, pct, share } from './format.js';
 import { GROUPS, PARAMS, byKey, planOptions, validate } from './params.js';
 
 /** Plans faster than this (ms, planning and posting) are redone on every change. */
@@ -22,21 +24,60 @@ const AUTO_REPLAN_MS = 1500;
 const REPLAN_DELAY_MS = 300;
 /** G-code lines shown around the current one. */
 const LISTING_LINES = 13;
+/** Values longer than this (characters) go on their own line under their label, per list
+ * (the model panel is the narrower). */
+const WIDE_VALUE_CHARS = { summary: 16, stats: 22 };
 /** Largest model file accepted (bytes). */
 const MAX_FILE_BYTES = 64 * 1048576;
 const FILE_TYPES = ['.json', '.tsm', '.obj'];
 const GCODE_EXT = { heidenhain: 'h', siemens: 'mpf' };
+/** The simulation's error bound aimed for, as a share of the scallop: a quarter, as
+ * `tspath plan --verify` (its VERIFY_BOUND_SHARE). */
+const VERIFY_BOUND_SHARE = 0.25;
+
+/** The public T-Splines files served beside the page (www/models/grapetec/, see SOURCE.md
+ * there), offered next to the built-in samples; `?model=grapetec/Bike.tsm` opens one. */
+const PUBLIC_SOURCE = {
+  dir: 'grapetec',
+  group: 'Public T-spline files (GrapeTec/T-SPLINE, LGPL-3.0)',
+  repository: 'GrapeTec/T-SPLINE',
+  url: 'https://github.com/GrapeTec/T-SPLINE',
+  licence: 'LGPL-3.0',
+  licenceFile: 'LICENSE.LGPL-3.0',
+};
+const PUBLIC_MODELS = [
+  ['simple.tsm', 'a few faces'],
+  ['mouse.tsm', 'computer-mouse shell'],
+  ['face.tsm', 'face, creases'],
+  ['Bike.tsm', 'bicycle seat'],
+  ['fan.tsm', 'fan blade'],
+  ['gearbox2-9.tsm', 'gearbox cover'],
+].map(([file, what]) => ({ id: `${PUBLIC_SOURCE.dir}/${file}`, file, what }));
+const publicModel = (name) => PUBLIC_MODELS.find((m) => m.id === name || m.file === name) || null;
+
+/** Problem kinds of the report, as a short heading. */
+const PROBLEM_KINDS = {
+  rest_faces_away: 'Not machined: faces away',
+  rest_tool_hits: 'Not machined: shank or holder would hit',
+  rest_no_way_out: 'Not machined: no way in or out',
+  rest_too_tight: 'Rest material: tighter than the ball',
+  turn_margin: 'Turn within the safety margin',
+  scallop: 'Scallop above the request',
+  gouge: 'Gouge',
+  unproven: 'Not proven by the simulation',
+};
 
 const TEMPLATE = `
 <div class="app" part="app">
   <aside class="controls" aria-label="Model and parameters">
     <section class="model">
       <h2>Model</h2>
-      <label for="sample">Built-in sample</label>
+      <label for="sample">Built-in sample or public model</label>
       <select id="sample"></select>
       <label for="file">Open a model file (.tsm, .obj, .json) — or drop it on the view</label>
       <input id="file" type="file" accept=".json,.tsm,.obj">
       <dl id="summary" class="facts" aria-label="Model summary"></dl>
+      <p id="concave-hint" class="hint"></p>
       <div id="patch-legend" class="legend" aria-label="Patch colours"></div>
     </section>
     <form id="params" novalidate></form>
@@ -55,12 +96,14 @@ const TEMPLATE = `
         aria-label="3D view of the model and the tool path. Drag to orbit, right-drag or shift-drag to pan, wheel to zoom; arrow keys orbit, shift+arrows pan, + and - zoom, F fits"></canvas>
       <div id="drop-hint" class="drop-hint" hidden>Drop a .tsm, .obj or .json model to open it</div>
       <div id="heat-legend" class="heat-legend" hidden aria-label="Heat map colours"></div>
+      <div id="rest-legend" class="rest-legend" hidden aria-label="Rest area colours"></div>
     </div>
     <div class="layers" role="group" aria-label="What the view shows">
       <span class="radio" role="radiogroup" aria-label="Surface colours">
         <label class="inline"><input type="radio" name="colour" id="colour-patches" value="patches" checked> Patches</label>
         <label class="inline"><input type="radio" name="colour" id="colour-heat" value="heat" disabled> Scallop heat map</label>
       </span>
+      <label class="inline" title="What the plan leaves unmachined, coloured by why"><input type="checkbox" id="layer-rest" checked disabled> Rest area</label>
       <label class="inline"><input type="checkbox" id="layer-path" checked> Path</label>
       <label class="inline"><input type="checkbox" id="layer-tool" checked> Tool</label>
       <label class="inline"><input type="checkbox" id="layer-cage"> Control mesh</label>
@@ -76,10 +119,15 @@ const TEMPLATE = `
     <div id="path-legend" class="legend path-legend" aria-label="Path colours"></div>
   </div>
   <aside class="results" aria-label="Results">
-    <section class="stats-section">
+    <section class="stats-section" id="stats-section">
       <h2>Statistics</h2>
+      <p id="stale-note" class="stale-note" hidden>The parameters changed: these results are for the plan drawn, made with the previous ones. Plan again to download.</p>
+      <div id="problems-box" class="problems-box" hidden>
+        <h3 id="problems-title">Problems</h3>
+        <ul id="problems" class="problems" aria-labelledby="problems-title"></ul>
+      </div>
       <dl id="stats" class="facts"></dl>
-      <ul id="notes" class="notes"></ul>
+      <ul id="notes" class="notes" aria-label="Notes"></ul>
     </section>
     <section class="listing-section">
       <h2 id="listing-title">G-code</h2>
@@ -94,7 +142,8 @@ const TEMPLATE = `
   </aside>
 </div>`;
 
-/** Statistics rows: id, label, value from (report, verification, context). */
+/** Statistics rows: id, label, value from (report, verification summary, context); the
+ * context has `verify_ms`, `area_mm2` (the model's) and `samples` (the simulation's start). */
 const STATS = [
   ['length_mm', 'Path length', (r) => mm(r.length_mm, 1)],
   ['cutting_length_mm', 'Cutting length', (r) => mm(r.cutting_length_mm, 1)],
@@ -103,22 +152,35 @@ const STATS = [
   ['reversals', 'Reversals', (r) => int(r.reversals)],
   ['cl_points', 'CL points', (r) => int(r.cl_points)],
   ['patches', 'Patches cut', (r) => int(r.patches)],
+  ['unreachable_area_mm2', 'Area not machined', (r, v, x) => {
+    const a = r.unreachable_area_mm2;
+    if (!(a > 0)) return '0 mm²';
+    return `${area(a)} (${share(a, x.area_mm2)} of ${area(x.area_mm2)})`;
+  }],
   ['max_predicted_scallop_mm', 'Predicted max scallop', (r) => mm(r.max_predicted_scallop_mm, 4)],
   ['max_scallop_mm', 'Simulated max scallop', (r, v) => (v ? mm(v.max_scallop_mm, 4) : '…')],
   ['mean_scallop_mm', 'Simulated mean scallop', (r, v) => (v ? mm(v.mean_scallop_mm, 4) : '…')],
   ['uncut_fraction', 'Area above the scallop asked', (r, v) => (v ? pct(v.uncut_fraction) : '…')],
   ['unreached_fraction', 'Area the tool never reached', (r, v) => (v ? pct(v.unreached_fraction) : '…')],
   ['max_gouge_mm', 'Deepest gouge', (r, v) => (v ? mm(v.max_gouge_mm, 4) : '…')],
-  ['gouge_count', 'Gouges beyond the chordal tolerance', (r, v) => (v ? `${int(v.gouge_count)} samples` : '…')],
+  ['gouge_count', 'Gouges beyond the gouge tolerance', (r, v) => (v ? `${int(v.gouge_count)} samples (${mm(v.gouge_tolerance_mm, 4)})` : '…')],
   ['error_bound_mm', 'Simulation error bound', (r, v) => {
     if (!v) return '…';
     return Number.isFinite(v.error_bound_mm) ? mm(v.error_bound_mm, 4) : 'not bounded';
+  }],
+  ['error_bound_target_mm', 'Bound aimed for (¼ of the scallop)', (r, v) => {
+    if (!v) return '…';
+    const t = v.error_bound_target_mm;
+    return v.error_bound_mm <= t ? `${mm(t, 4)}: reached` : `${mm(t, 4)}: not reached`;
+  }],
+  ['samples', 'Simulation samples', (r, v, x) => {
+    if (!v) return '…';
+    return v.samples === x.samples ? int(v.samples) : `${int(v.samples)} (grown from ${int(x.samples)})`;
   }],
   ['max_axis_step_deg', 'Largest tool-axis step', (r) => deg(r.max_axis_step_deg)],
   ['machining_time_min', 'Machining time', (r) => minutes(r.machining_time_min)],
   ['plan_ms', 'Planning time', (r) => ms(r.plan_ms)],
   ['verify_ms', 'Simulation time', (r, v, x) => (v ? ms(x.verify_ms) : '…')],
-  ['samples', 'Simulation samples', (r, v) => (v ? int(v.samples) : '…')],
 ];
 /** Raw value of a statistic (for data-value), where it has one. */
 function rawStat(id, r, v) {
@@ -168,7 +230,7 @@ export class TspathPlanner extends HTMLElement {
   attributeChangedCallback(name, old, value) {
     if (!this.ready || old === value) return;
     if (name === 'model') {
-      if (value && value !== this.$('sample').value) this.#loadSample(value);
+      if (value && value !== this.$('sample').value) this.#loadNamed(value);
       return;
     }
     const el = this.$(`p-${name}`);
@@ -185,10 +247,29 @@ export class TspathPlanner extends HTMLElement {
     return this.dataset.state;
   }
 
-  #status(text, isError = false) {
+  /** The status line; `tone` is `error` (also `true`), `warning` or nothing. */
+  #status(text, tone = '') {
     const el = this.$('status');
     el.textContent = text;
-    el.classList.toggle('error', isError);
+    const t = tone === true ? 'error' : tone || '';
+    el.classList.toggle('error', t === 'error');
+    el.classList.toggle('warning', t === 'warning');
+  }
+
+  /** The status line for the plan shown: what its report (with the simulation's findings,
+   * once simulated) says, loud when it leaves something undone. `extra` is appended. */
+  #planStatus(extra = '') {
+    const p = this.plan;
+    if (!p) return;
+    const r = p.report;
+    const v = p.verification?.summary;
+    const sim = v ? ` Simulated max scallop ${mm(v.max_scallop_mm, 4)}.` : '';
+    if (r.status === 'planned_with_problems') {
+      const n = r.problems.length;
+      this.#status(`Planned with problems: ${int(r.cl_points)} CL points in ${ms(r.plan_ms)}; ${n} problem${n === 1 ? '' : 's'} (listed with the statistics).${sim}${extra}`, 'warning');
+    } else {
+      this.#status(`Planned ${int(r.cl_points)} CL points in ${ms(r.plan_ms)}.${sim}${extra}`);
+    }
   }
 
   // ---------------------------------------------------------------- start
@@ -214,7 +295,16 @@ export class TspathPlanner extends HTMLElement {
     }));
     this.#fillChoice('machine', info.machines.map((m) => [m.name, `${m.name}${this.machineRotaries[m.name].rotaries ? ' (five-axis)' : ''}`]));
     this.#fillChoice('dialect', info.dialects.map((d) => [d, d]));
-    for (const n of info.samples) this.$('sample').append(new Option(n, n));
+    const builtIn = document.createElement('optgroup');
+    builtIn.label = 'Built-in samples';
+    for (const n of info.samples) builtIn.append(new Option(n, n));
+    const files = document.createElement('optgroup');
+    files.label = PUBLIC_SOURCE.group;
+    for (const m of PUBLIC_MODELS) files.append(new Option(`${m.file} (${m.what})`, m.id));
+    this.$('sample').append(builtIn, files);
+    if (info.verifyMaxSamples !== byKey['max-samples'].default) {
+      console.warn(`The engine's simulation cap is ${info.verifyMaxSamples} samples, the page's default ${byKey['max-samples'].default}`);
+    }
 
     // Initial values: attributes, then the URL if synced.
     const initial = {};
@@ -231,7 +321,7 @@ export class TspathPlanner extends HTMLElement {
     this.ready = true;
     this.#validateAll();
     const model = initial.model || info.samples[0];
-    const loaded = await this.#loadSample(model);
+    const loaded = await this.#loadNamed(model);
     const planFlag = initial.plan;
     if (loaded && planFlag !== undefined && planFlag !== null && planFlag !== '0' && planFlag !== 'false') {
       this.#plan();
@@ -323,7 +413,7 @@ export class TspathPlanner extends HTMLElement {
     const $ = this.$;
     $('plan').addEventListener('click', () => this.#plan());
     $('cancel').addEventListener('click', () => this.#cancel());
-    $('sample').addEventListener('change', () => this.#loadSample($('sample').value));
+    $('sample').addEventListener('change', () => this.#loadNamed($('sample').value));
     $('file').addEventListener('change', () => {
       const f = $('file').files[0];
       if (f) this.#openFile(f);
@@ -335,6 +425,14 @@ export class TspathPlanner extends HTMLElement {
     for (const k of ['path', 'tool', 'cage', 'eps']) {
       $(`layer-${k}`).addEventListener('change', () => this.view.setLayers({ [k]: $(`layer-${k}`).checked }));
     }
+    $('layer-rest').addEventListener('change', () => {
+      this.restHidden = !$('layer-rest').checked; // kept for the next plans
+      this.#showRestLayer();
+    });
+    $('problems').addEventListener('click', (e) => {
+      const b = e.target.closest('button[data-move]');
+      if (b) this.#showMove(Number(b.dataset.move), b.dataset.at ? JSON.parse(b.dataset.at) : null);
+    });
     for (const id of ['colour-patches', 'colour-heat']) $(id).addEventListener('change', () => this.#showColours());
     $('scrub').addEventListener('input', () => this.#scrubTo(Number($('scrub').value)));
     $('play').addEventListener('click', () => this.#togglePlay());
@@ -365,13 +463,38 @@ export class TspathPlanner extends HTMLElement {
 
   // ---------------------------------------------------------------- models
 
-  async #loadSample(name) {
+  /** Loads a built-in sample or one of the public files by its picker name. */
+  async #loadNamed(name) {
+    const pub = publicModel(name);
+    if (pub) return this.#loadPublic(pub);
     if (this.info && !this.info.samples.includes(name)) {
-      this.#status(`There is no sample “${name}”; the samples are ${this.info.samples.join(', ')}.`, true);
+      const files = PUBLIC_MODELS.map((m) => m.id).join(', ');
+      this.#status(`There is no model “${name}”: the samples are ${this.info.samples.join(', ')}; the public files ${files}.`, true);
       if (!this.model) this.state = 'error';
+      if (this.model) this.$('sample').value = this.model.sample ?? '';
       return false;
     }
     return this.#load({ sample: name }, name);
+  }
+
+  /** Fetches a public .tsm file from beside this module and loads it as an opened file. */
+  async #loadPublic(m) {
+    if (this.planning || this.dataset.verify === 'running') this.#cancel(true);
+    const url = new URL(`./models/${m.id}`, import.meta.url);
+    this.state = 'loading';
+    this.#status(`Fetching ${m.file}…`);
+    let buf;
+    try {
+      const res = await fetch(url);
+      if (!res.ok) throw new Error(`the server answered ${res.status} ${res.statusText} for ${url.pathname}`);
+      buf = await res.arrayBuffer();
+    } catch (e) {
+      this.state = this.model ? (this.plan ? 'planned' : 'model-loaded') : 'error';
+      this.#status(`Could not fetch ${m.file}: ${e.message}`, true);
+      if (this.model) this.$('sample').value = this.model.sample ?? '';
+      return false;
+    }
+    return this.#load({ bytes: buf, name: m.file.replace(/\.[^.]*$/, '') }, m.file, m);
   }
 
   async #openFile(file) {
@@ -389,7 +512,9 @@ export class TspathPlanner extends HTMLElement {
     return this.#load({ bytes: buf, name: stem }, file.name);
   }
 
-  async #load(source, label) {
+  /** Loads a sample ({sample}) or file bytes ({bytes, name}); `pub` is the public model
+   * the bytes are, if one. */
+  async #load(source, label, pub = null) {
     if (this.planning || this.dataset.verify === 'running') this.#cancel(true);
     this.state = 'loading';
     this.#status(`Loading ${label}…`);
@@ -402,11 +527,13 @@ export class TspathPlanner extends HTMLElement {
       if (this.model) this.$('sample').value = this.model.sample ?? '';
       return false;
     }
-    this.model = { ...m, sample: source.sample ?? null, file: source.sample ? null : label };
+    // `sample`: the picker's (and the URL's) name for it, null for a file of the user's.
+    const sample = source.sample ?? pub?.id ?? null;
+    this.model = { ...m, sample, file: source.sample ? null : label, pub };
     this.#clearPlan();
     this.$('colour-patches').checked = true;
-    this.$('sample').value = source.sample ?? '';
-    this.#showSummary(m.summary);
+    this.$('sample').value = sample ?? '';
+    this.#showSummary(m.summary, pub);
     this.#fillPatchChoices(m.summary.patches);
     this.view.setModel(m);
     this.#showColours();
@@ -424,8 +551,9 @@ export class TspathPlanner extends HTMLElement {
     return true;
   }
 
-  #showSummary(s) {
+  #showSummary(s, pub) {
     const size = s.bbox_mm.max.map((v, k) => v - s.bbox_mm.min[k]);
+    const concave = s.smallest_concave_radius;
     const rows = [
       ['Name', s.name],
       ['Format', s.format + (s.units_read && s.units_read !== 'mm' ? ` (${s.units_read})` : '')],
@@ -436,8 +564,34 @@ export class TspathPlanner extends HTMLElement {
       ['Extraordinary points', int(s.extraordinary_points)],
       ['T-junctions', int(s.t_junctions)],
       ['Holes', int(s.holes)],
+      ['Smallest concave radius', concave ? mmSig(concave.radius_mm) : 'none (nothing concave)', concave ? concave.radius_mm : ''],
     ];
-    this.#facts(this.$('summary'), rows.map(([k, v]) => [k.toLowerCase().replace(/\W+/g, '-'), k, v]));
+    this.#facts(this.$('summary'), rows.map(([k, v, raw]) => [k.toLowerCase().replace(/\W+/g, '-'), k, v, raw]));
+    if (pub) {
+      // Where the file comes from and under which licence, linked (the licence is served
+      // beside the file).
+      const dt = document.createElement('dt');
+      dt.textContent = 'Source';
+      const dd = document.createElement('dd');
+      dd.id = 'summary-source';
+      const repo = document.createElement('a');
+      repo.href = PUBLIC_SOURCE.url;
+      repo.target = '_blank';
+      repo.rel = 'noopener';
+      repo.textContent = PUBLIC_SOURCE.repository;
+      const licence = document.createElement('a');
+      licence.href = new URL(`./models/${PUBLIC_SOURCE.dir}/${PUBLIC_SOURCE.licenceFile}`, import.meta.url).href;
+      licence.target = '_blank';
+      licence.textContent = PUBLIC_SOURCE.licence;
+      const about = document.createElement('a');
+      about.href = new URL(`./models/${PUBLIC_SOURCE.dir}/SOURCE.md`, import.meta.url).href;
+      about.target = '_blank';
+      about.textContent = 'about';
+      dd.append(repo, `, rhino/${pub.file}; licence `, licence, ' (', about, ')');
+      dd.classList.add('wide');
+      this.$('summary').append(dt, dd);
+    }
+    this.#concaveHint();
     const legend = this.$('patch-legend');
     legend.replaceChildren();
     if (s.patches <= 40) {
@@ -451,6 +605,28 @@ export class TspathPlanner extends HTMLElement {
     }
   }
 
+  /** Under the summary: what the smallest concave radius means for the ball chosen. */
+  #concaveHint() {
+    const el = this.$('concave-hint');
+    const c = this.model?.summary.smallest_concave_radius;
+    if (!this.model) {
+      el.textContent = '';
+      return;
+    }
+    if (!c) {
+      el.textContent = 'Nothing is concave: a ball of any radius reaches everywhere the surface is smooth.';
+      el.classList.remove('warn');
+      return;
+    }
+    const r = Number(this.$('p-tool-radius').value);
+    const at = c.at_mm.map((x) => x.toFixed(2)).join(', ');
+    const big = Number.isFinite(r) && r > c.radius_mm;
+    el.textContent = `A ball of radius above ${mmSig(c.radius_mm)} cannot reach the bottom of the tightest concave spot (at ${at} mm): `
+      + 'it leaves material there, rest material where that is more than the scallop height'
+      + (big ? ` (the ${r} mm ball chosen is larger).` : '. The ball chosen fits.');
+    el.classList.toggle('warn', big);
+  }
+
   #facts(dl, rows) {
     dl.replaceChildren();
     for (const [id, label, text, raw] of rows) {
@@ -459,6 +635,8 @@ export class TspathPlanner extends HTMLElement {
       const dd = document.createElement('dd');
       dd.id = `${dl.id}-${id}`;
       dd.textContent = text;
+      // A long value takes the whole width, on the line under its label.
+      if (String(text).length > (WIDE_VALUE_CHARS[dl.id] ?? 22)) dd.classList.add('wide');
       if (raw !== undefined && raw !== '') dd.dataset.value = String(raw);
       dl.append(dt, dd);
     }
@@ -519,8 +697,17 @@ export class TspathPlanner extends HTMLElement {
 
   #onParamChange(key) {
     if (key === 'machine') this.#updateMachineControls();
+    if (key === 'tool-radius') this.#concaveHint();
     const v = this.#validateAll();
     this.#syncUrl();
+    // Whatever the change, the plan shown stays downloadable only while it is the plan of
+    // the parameters shown (an invalid value is not that plan's either).
+    const matches = this.#planMatches();
+    this.#markStale(!!this.plan && !matches);
+    if (matches && (key === 'dialect' || key === 'units' || key === 'machine')) {
+      this.#post();
+      if (!v.errors) return;
+    }
     if (v.errors) {
       this.#status(v.errors[0], true);
       return;
@@ -529,29 +716,23 @@ export class TspathPlanner extends HTMLElement {
       this.#status('Ready to plan.');
       return;
     }
-    const opts = this.#planOptions(v.values);
-    const samePlan = this.plan && JSON.stringify(opts) === JSON.stringify(this.plan.options);
-    if (samePlan && (key === 'dialect' || key === 'units' || key === 'machine')) {
-      this.#post();
-      return;
-    }
-    if (samePlan && key === 'samples') {
-      this.#verify();
-      return;
-    }
-    if (samePlan) return;
     if (this.planning) {
       this.replanAfter = true;
       return;
     }
-    this.#markStale(true);
+    if (matches) {
+      clearTimeout(this.replanTimer);
+      if (key === 'samples' || key === 'max-samples') this.#verify();
+      else this.#planStatus();
+      return;
+    }
     const fast = this.lastPlanMs !== undefined && this.lastPlanMs < AUTO_REPLAN_MS;
     if (this.$('auto').checked && fast) {
       clearTimeout(this.replanTimer);
       this.replanTimer = setTimeout(() => this.#plan(), REPLAN_DELAY_MS);
       this.#status('Parameters changed: re-planning…');
     } else {
-      this.#status('Parameters changed: press “Plan tool path” to plan again.');
+      this.#status('Parameters changed: press “Plan tool path” to plan again (the downloads wait for it).');
     }
   }
 
@@ -559,9 +740,51 @@ export class TspathPlanner extends HTMLElement {
     return planOptions(values, { fiveAxis: this.#fiveAxis });
   }
 
+  /** Whether the plan shown is the plan of the parameters as they are now: every plan
+   * parameter valid and giving the same options. */
+  #planMatches() {
+    if (!this.plan) return false;
+    const { values, errors } = validate(this.#raw(), {
+      patches: this.model ? this.model.summary.patches : 1,
+      fiveAxis: this.#fiveAxis,
+    });
+    if (PARAMS.some((p) => p.field && errors[p.key])) return false;
+    return JSON.stringify(this.#planOptions(values)) === JSON.stringify(this.plan.options);
+  }
+
+  /** Greys the results and turns the plan's downloads off while they are not the plan of
+   * the parameters shown. */
   #markStale(stale) {
+    this.$('stats-section').classList.toggle('stale', stale);
     this.$('stats').classList.toggle('stale', stale);
+    this.$('stale-note').hidden = !stale;
     this.toggleAttribute('data-stale', stale);
+    this.#updateDownloads();
+  }
+
+  /** The G-code and CL downloads are on only for the plan shown, while it matches the
+   * parameters, and the G-code only once written for the machine, dialect and units shown;
+   * their titles say why not. */
+  #updateDownloads() {
+    const p = this.plan;
+    const stale = this.hasAttribute('data-stale');
+    const gcode = this.$('download-gcode');
+    const csv = this.$('download-csv');
+    const [machine, dialect, units] = ['machine', 'dialect', 'units'].map((k) => this.$(`p-${k}`).value);
+    let why = '';
+    if (!p) why = 'Nothing is planned yet: plan first';
+    else if (stale) why = 'The parameters changed since this plan was made: plan again to download';
+    csv.disabled = !!why;
+    csv.title = why || 'The CL data of the plan shown (CSV, mm)';
+    const g = p && p.gcode;
+    const written = g && g.machine === machine && g.dialect === dialect && g.units === units;
+    if (!why && !written) {
+      why = this.posting ? `Writing the program for ${machine} in ${dialect}…`
+        : `No program for ${machine} in ${dialect} (${units}): see the status line`;
+    }
+    gcode.disabled = !!why;
+    gcode.title = why || `The program of the plan shown for ${machine} in ${dialect}, ${units}`;
+    gcode.textContent = written ? `G-code (${dialect}, ${units})` : 'G-code';
   }
 
   // ---------------------------------------------------------------- planning
@@ -610,8 +833,11 @@ export class TspathPlanner extends HTMLElement {
     }
     if (token !== this.planToken) return;
     this.#clearPlan();
-    this.plan = { ...result, options, values: v.values, workerHasPlan: true };
+    // `report` is what the page shows: the plan's own (`planReport`), and once simulated
+    // the same with the simulation's findings added.
+    this.plan = { ...result, planReport: result.report, options, values: v.values, workerHasPlan: true };
     this.view.setPath(result);
+    this.#showRest();
     this.#showTool(v.values);
     const n = result.kinds.length;
     const scrub = this.$('scrub');
@@ -619,21 +845,21 @@ export class TspathPlanner extends HTMLElement {
     scrub.value = '0';
     scrub.disabled = n === 0;
     this.$('play').disabled = n === 0;
-    this.$('download-csv').disabled = false;
     this.#showStats();
-    this.#markStale(false);
+    this.#markStale(!this.#planMatches());
     this.#endPlanning();
     this.state = 'planned';
+    this.dataset.status = result.report.status;
     this.dataset.verify = 'pending';
-    const r = result.report;
-    this.#status(`Planned ${int(r.cl_points)} CL points in ${ms(r.plan_ms)}.`);
+    this.#planStatus();
     await this.#post();
     this.lastPlanMs = performance.now() - t0;
     this.dataset.plans = String(Number(this.dataset.plans || 0) + 1);
     this.#scrubTo(0);
     this.#syncUrl();
-    if (this.replanAfter) {
-      this.replanAfter = false;
+    const again = this.replanAfter && !this.#planMatches();
+    this.replanAfter = false;
+    if (again) {
       this.#plan();
       return;
     }
@@ -692,33 +918,34 @@ export class TspathPlanner extends HTMLElement {
     }
   }
 
+  /** Writes the program of the plan for the machine, dialect and units shown (choices
+   * that are always valid, so a wrong number elsewhere does not hold the program back). */
   async #post() {
     if (!this.plan) return;
     const plan = this.plan;
-    const values = this.#validateAll().values;
-    if (!values) return;
-    const { machine, dialect, units } = values;
-    this.$('download-gcode').disabled = true;
-    this.$('download-gcode').textContent = 'G-code';
-    if (!(await this.#ensureWorkerPlan())) return;
+    const [machine, dialect, units] = ['machine', 'dialect', 'units'].map((k) => this.$(`p-${k}`).value);
+    this.posting = (this.posting || 0) + 1;
+    this.#updateDownloads();
     try {
+      if (!(await this.#ensureWorkerPlan())) return;
       const g = await this.client.call('post', [machine, dialect, units]);
       if (plan !== this.plan) return;
       plan.gcode = { ...g, machine, dialect, units, lineStarts: null, lineCount: 0 };
       this.#indexLines(plan.gcode);
-      this.$('download-gcode').disabled = false;
-      this.$('download-gcode').textContent = `G-code (${dialect}, ${units})`;
       this.$('listing-title').textContent = `G-code: ${machine}, ${dialect}, ${units}`;
       this.$('p-machine').removeAttribute('aria-invalid');
       this.$('p-dialect').removeAttribute('aria-invalid');
       this.#scrubTo(Number(this.$('scrub').value));
-      if (this.$('status').classList.contains('error')) this.#status('Program written.');
+      if (this.$('status').classList.contains('error') && !this.#validateAll().errors) this.#planStatus(' Program written.');
     } catch (e) {
       if (e instanceof CancelledError || plan !== this.plan) return;
       plan.gcode = null;
       this.$('listing').replaceChildren();
       this.$('listing-title').textContent = 'G-code';
       this.#status(`Could not write the program for ${machine} in ${dialect}: ${e.message}`, true);
+    } finally {
+      this.posting--;
+      this.#updateDownloads();
     }
   }
 
@@ -737,29 +964,40 @@ export class TspathPlanner extends HTMLElement {
     return g.text.slice(a, b).replace(/\n$/, '');
   }
 
+  /** Simulates the cut of the plan shown as `tspath plan --verify --verify-samples N
+   * --verify-max-samples M` does: from `samples` the count grows until the error bound is a
+   * quarter of the scallop or reaches `max-samples`; the rest area is measured apart. The
+   * report then takes in what the simulation found. */
   async #verify() {
     if (!this.plan) return;
     const plan = this.plan;
-    const values = this.#validateAll().values;
-    if (!values) return;
+    const { values, errors } = validate(this.#raw(), { patches: this.model.summary.patches, fiveAxis: this.#fiveAxis });
+    if (errors.samples || errors['max-samples']) return;
     const token = (this.verifyToken = (this.verifyToken || 0) + 1);
     this.dataset.verify = 'running';
     this.$('cancel').disabled = false;
     this.$('colour-heat').disabled = true;
     plan.verification = null;
+    plan.report = plan.planReport;
+    this.dataset.status = plan.report.status;
     this.#showStats();
+    this.#showColours();
     if (!(await this.#ensureWorkerPlan())) return;
-    const base = this.$('status').textContent;
-    this.#status(`${base} Simulating the cut…`);
+    const start = values.samples;
+    const bound = plan.options.scallop_mm * VERIFY_BOUND_SHARE;
+    const cap = values['max-samples'];
+    this.#planStatus(` Simulating the cut (from ${int(start)} samples until its error bound is ${mm(bound, 4)}, at most ${int(cap)} samples)…`);
     try {
-      const v = await this.client.call('verify', [{ samples: values.samples }]);
+      const v = await this.client.call('verify', [{ samples: start, bound_mm: bound, max_samples: cap }]);
       if (token !== this.verifyToken || plan !== this.plan) return;
-      plan.verification = v;
+      plan.verification = { ...v, samples: start };
+      plan.report = v.report;
+      this.dataset.status = v.report.status;
       this.dataset.verify = 'done';
       this.$('colour-heat').disabled = false;
       this.#showStats();
       this.#showColours();
-      this.#status(`${base} Simulated max scallop ${mm(v.summary.max_scallop_mm, 4)}.`);
+      if (!this.hasAttribute('data-stale') && !this.$('status').classList.contains('error')) this.#planStatus();
     } catch (e) {
       if (token !== this.verifyToken || e instanceof CancelledError) return;
       this.dataset.verify = 'error';
@@ -776,6 +1014,7 @@ export class TspathPlanner extends HTMLElement {
       this.view.setPath(null);
       this.view.setTool(null);
       this.view.setHeat(null);
+      this.view.setRest(null);
     }
     this.$('colour-heat').disabled = true;
     this.$('scrub').disabled = true;
@@ -784,13 +1023,15 @@ export class TspathPlanner extends HTMLElement {
     this.$('tool-readout').textContent = 'no path yet';
     this.$('listing').replaceChildren();
     this.$('listing-title').textContent = 'G-code';
-    this.$('download-gcode').disabled = true;
-    this.$('download-gcode').textContent = 'G-code';
-    this.$('download-csv').disabled = true;
     this.$('stats').replaceChildren();
     this.$('notes').replaceChildren();
+    this.$('problems').replaceChildren();
+    this.$('problems-box').hidden = true;
     this.$('heat-legend').hidden = true;
+    this.$('rest-legend').hidden = true;
+    this.$('layer-rest').disabled = true;
     delete this.dataset.verify;
+    delete this.dataset.status;
     this.#markStale(false);
   }
 
@@ -799,16 +1040,149 @@ export class TspathPlanner extends HTMLElement {
     if (!p) return;
     const r = p.report;
     const v = p.verification ? p.verification.summary : null;
-    const rows = STATS.map(([id, label, f]) => [id, label, f(r, v, p.verification || {}), rawStat(id, r, v)]);
+    const ctx = { ...(p.verification || {}), area_mm2: this.model.area_mm2 };
+    const rows = STATS.map(([id, label, f]) => [id, label, f(r, v, ctx), rawStat(id, r, v)]);
     const time = rows.find((x) => x[0] === 'machining_time_min');
     time[1] = `Machining time at ${int(p.options.feed_mm_min ?? 1000)} mm/min`;
     this.#facts(this.$('stats'), rows);
+    if (v) this.$('stats-error_bound_target_mm').dataset.reached = String(v.error_bound_mm <= v.error_bound_target_mm);
+    this.#showProblems();
     const notes = this.$('notes');
     notes.replaceChildren(...(r.notes || []).map((t) => {
       const li = document.createElement('li');
       li.textContent = t;
       return li;
     }));
+  }
+
+  /** The report's problems, each with its message (numbers in mm and mm²) and, where it has
+   * a place, a button that puts the tool at the move nearest it. */
+  #showProblems() {
+    const p = this.plan;
+    const list = this.$('problems');
+    const problems = p.report.problems || [];
+    list.replaceChildren(...problems.map((q, k) => {
+      const li = document.createElement('li');
+      li.dataset.kind = q.kind;
+      const head = document.createElement('strong');
+      head.textContent = `${PROBLEM_KINDS[q.kind] || q.kind}: `;
+      li.append(head, q.message);
+      const move = q.near_move ?? (q.at_mm ? this.#nearestMove(q.at_mm) : null);
+      if (move !== null && move !== undefined) {
+        const b = document.createElement('button');
+        b.type = 'button';
+        b.className = 'link';
+        b.dataset.move = String(move);
+        if (q.at_mm) b.dataset.at = JSON.stringify(q.at_mm);
+        b.id = `problem-${k}-show`;
+        b.textContent = q.near_move !== null && q.near_move !== undefined
+          ? `Show the tool there (move ${int(move)})`
+          : `Show the tool at the nearest move (${int(move)})`;
+        li.append(' ', b);
+      }
+      return li;
+    }));
+    this.$('problems-box').hidden = problems.length === 0;
+    this.$('problems-title').textContent = problems.length ? `Problems (${problems.length})` : 'Problems';
+  }
+
+  /** The cutting move whose contact point is nearest `at` (mm), for problems that have a
+   * place but no move (the simulation's). */
+  #nearestMove(at) {
+    const { cc, kinds } = this.plan;
+    let best = null;
+    let bestD = Infinity;
+    for (let i = 0; i < kinds.length; i++) {
+      if (KINDS[kinds[i]]?.name !== 'feed') continue;
+      const d = (cc[3 * i] - at[0]) ** 2 + (cc[3 * i + 1] - at[1]) ** 2 + (cc[3 * i + 2] - at[2]) ** 2;
+      if (d < bestD) {
+        bestD = d;
+        best = i;
+      }
+    }
+    return best;
+  }
+
+  /** Puts the tool at move `i` (as scrubbing there does) and frames the spot `at` (mm; the
+   * move's contact point if not given) a few tool sizes wide. */
+  #showMove(i, at = null) {
+    const p = this.plan;
+    if (!p) return;
+    this.#stopPlay();
+    this.$('scrub').value = String(i);
+    this.#scrubTo(i);
+    if (!this.$('layer-tool').checked) {
+      this.$('layer-tool').checked = true;
+      this.view.setLayers({ tool: true });
+    }
+    const spot = at || [p.cc[3 * i], p.cc[3 * i + 1], p.cc[3 * i + 2]];
+    // Wide enough for the rest region there (the report's problems name its largest).
+    const region = at && p.report.rest.find((g) => g.centre_mm.every((x, k) => x === at[k]));
+    const size = region ? 1.2 * Math.sqrt(region.area_mm2 / Math.PI) : 0;
+    const r = p.options.tool_radius_mm;
+    this.view.focus(spot, Math.max(8 * r, 0.1 * this.view.modelRadius, size), this.#toolSideNormal(spot));
+  }
+
+  /** The unit normal of the drawn surface at its vertex nearest `at` (mm), on the side the
+   * tool works from (that of the plan's cuts: ball centre minus contact point), so that the
+   * view looks at the spot from outside; null if the plan has no cut. */
+  #toolSideNormal(at) {
+    const { positions: x, normals: n } = this.model;
+    const nearest = (q) => {
+      let best = 0;
+      let bestD = Infinity;
+      for (let v = 0; v < x.length; v += 3) {
+        const d = (x[v] - q[0]) ** 2 + (x[v + 1] - q[1]) ** 2 + (x[v + 2] - q[2]) ** 2;
+        if (d < bestD) {
+          bestD = d;
+          best = v;
+        }
+      }
+      return best;
+    };
+    const { cl, cc, kinds } = this.plan;
+    const cut = kinds.findIndex((k) => KINDS[k]?.name === 'feed');
+    if (cut < 0) return null;
+    const c = 3 * cut;
+    const w = nearest([cc[c], cc[c + 1], cc[c + 2]]);
+    const side = Math.sign((cl[c] - cc[c]) * n[w] + (cl[c + 1] - cc[c + 1]) * n[w + 1] + (cl[c + 2] - cc[c + 2]) * n[w + 2]) || 1;
+    const v = nearest(at);
+    return [side * n[v], side * n[v + 1], side * n[v + 2]];
+  }
+
+  /** The plan's rest area in the view, and its legend (area per reason). */
+  #showRest() {
+    const p = this.plan;
+    const has = p && (p.rest.length > 0 || p.report.rest.length > 0);
+    this.view.setRest(has ? { positions: p.rest, reasons: p.restReasons, regions: p.report.rest } : null);
+    const box = this.$('layer-rest');
+    box.disabled = !has;
+    box.checked = has && !this.restHidden;
+    const legend = this.$('rest-legend');
+    legend.replaceChildren();
+    if (has) {
+      const title = document.createElement('div');
+      title.className = 'title';
+      title.textContent = `Rest area ${area(p.report.unreachable_area_mm2)}`;
+      legend.append(title);
+      for (const reason of REST_REASONS) {
+        const regions = p.report.rest.filter((r) => r.why === reason.why);
+        if (!regions.length) continue;
+        const sw = document.createElement('span');
+        sw.className = 'swatch';
+        sw.dataset.why = reason.why;
+        sw.style.setProperty('--c', hexCss(reason.colour));
+        sw.textContent = `${reason.label}: ${area(regions.reduce((a, r) => a + r.area_mm2, 0))}`;
+        legend.append(sw);
+      }
+    }
+    this.#showRestLayer();
+  }
+
+  #showRestLayer() {
+    const on = this.$('layer-rest').checked && !this.$('layer-rest').disabled;
+    this.view.setLayers({ rest: on });
+    this.$('rest-legend').hidden = !on;
   }
 
   // ---------------------------------------------------------------- view
@@ -955,13 +1329,13 @@ export class TspathPlanner extends HTMLElement {
 
   #downloadGcode() {
     const g = this.plan && this.plan.gcode;
-    if (!g) return;
+    if (!g || this.$('download-gcode').disabled) return;
     const ext = GCODE_EXT[g.dialect] || 'nc';
     download(`${this.#baseName()}-${g.dialect}.${ext}`, g.text, 'text/plain');
   }
 
   async #downloadCsv() {
-    if (!this.plan || !(await this.#ensureWorkerPlan())) return;
+    if (!this.plan || this.$('download-csv').disabled || !(await this.#ensureWorkerPlan())) return;
     try {
       const csv = await this.client.call('csv');
       download(`${this.#baseName()}-cl.csv`, csv, 'text/csv');
@@ -992,7 +1366,8 @@ export class TspathPlanner extends HTMLElement {
       if (v !== '' && v !== d && !(p.kind === 'number' && Number(v) === Number(d) && d !== '')) q.set(p.key, v);
     }
     if (this.plan) q.set('plan', '1');
-    const url = `${location.pathname}${q.toString() ? `?${q}` : ''}${location.hash}`;
+    const query = q.toString().replace(/%2F/g, '/'); // `model=grapetec/Bike.tsm` reads better
+    const url = `${location.pathname}${query ? `?${query}` : ''}${location.hash}`;
     if (url !== `${location.pathname}${location.search}${location.hash}`) history.replaceState(null, '', url);
   }
 
@@ -1016,7 +1391,8 @@ export class TspathPlanner extends HTMLElement {
     return n;
   }
 
-  /** Pixels a layer (`path`, `tool`, `cage`, `eps`) changes when shown (it is left as it was). */
+  /** Pixels a layer (`path`, `tool`, `cage`, `eps`, `rest`) changes when shown (it is left
+   * as it was). */
   layerPixels(layer) {
     const on = this.view.layers[layer];
     const n = this.pixelsChangedBy(() => this.view.setLayers({ [layer]: !on }));

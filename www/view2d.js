@@ -1,8 +1,9 @@
 // Fallback view for browsers without WebGL, on a 2D canvas: shaded surface triangles
-// (painter's algorithm), patch colours or the heat map, extraordinary points, control mesh,
-// the path by kind and the tool as its outline. Same interface as View3D. Z is up; mm.
+// (painter's algorithm), patch colours or the heat map, the rest area a plan leaves (by
+// reason, sorted with the surface, and a ring at each region), extraordinary points, control
+// mesh, the path by kind and the tool as its outline. Same interface as View3D. Z is up; mm.
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, KINDS, PATCH_COLOURS, heatColour, hexCss, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour,
 } from './colours.js';
 
 const rgb = (c) => [c >> 16 & 255, c >> 8 & 255, c & 255];
@@ -20,9 +21,10 @@ export class View2D {
     this.path = null;
     this.tool = null;
     this.heat = null;
+    this.rest = null;
     this.center = [0, 0, 0];
     this.radius = 1;
-    this.layers = { surface: true, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, path: true, tool: true, cage: false, eps: true };
     this.#bindInput();
     this.resizer = new ResizeObserver(() => this.resize());
     this.resizer.observe(canvas);
@@ -33,7 +35,8 @@ export class View2D {
     const dpr = Math.min(2, window.devicePixelRatio || 1);
     this.canvas.width = Math.max(1, Math.round(this.canvas.clientWidth * dpr));
     this.canvas.height = Math.max(1, Math.round(this.canvas.clientHeight * dpr));
-    this.render();
+    // Setting the size cleared the canvas: draw again at once, not a frame later.
+    this.renderNow();
   }
 
   setModel(m) {
@@ -41,11 +44,18 @@ export class View2D {
     this.heat = null;
     this.path = null;
     this.tool = null;
+    this.rest = null;
     this.fit();
   }
 
   setHeat(values, scallopMm) {
     this.heat = values ? { values, scallopMm } : null;
+    this.render();
+  }
+
+  /** The rest area (see View3D.setRest) or null. */
+  setRest(rest) {
+    this.rest = rest && (rest.positions.length || rest.regions?.length) ? rest : null;
     this.render();
   }
 
@@ -80,6 +90,25 @@ export class View2D {
     this.zoom = 1;
     this.pan = [0, 0];
     this.render();
+  }
+
+  /** Frames a sphere of `radius` (mm) round `centre`, seen from direction `from` (a unit
+   * vector from the centre towards the viewer; the current direction if null). */
+  focus(centre, radius, from = null) {
+    if (from) {
+      this.pitch = Math.max(-1.55, Math.min(1.55, Math.asin(Math.max(-1, Math.min(1, from[2])))));
+      if (Math.hypot(from[0], from[1]) > 1e-9) this.yaw = Math.atan2(-from[0], -from[1]);
+    }
+    this.zoom = Math.max(1, this.radius / Math.max(radius, 1e-9));
+    this.pan = [0, 0];
+    const q = this.#project()(...centre);
+    this.pan = [this.canvas.width / 2 - q[0], this.canvas.height / 2 - q[1]];
+    this.render();
+  }
+
+  /** The radius of the model's bounding sphere (mm). */
+  get modelRadius() {
+    return this.radius;
   }
 
   #project() {
@@ -121,13 +150,16 @@ export class View2D {
     ctx.fillRect(0, 0, width, height);
     if (!this.model) return;
     const proj = this.#project();
-    if (this.layers.surface) this.#drawSurface(proj);
+    if (this.layers.surface || (this.layers.rest && this.rest)) this.#drawSurface(proj);
+    if (this.layers.rest && this.rest) this.#drawRestRings(proj);
     if (this.layers.cage) this.#drawCage(proj);
     if (this.layers.eps) this.#drawEps(proj);
     if (this.layers.path && this.path) this.#drawPath(proj);
     if (this.layers.tool && this.tool) this.#drawTool(proj);
   }
 
+  /** Surface triangles and, with the rest layer, the rest triangles, sorted together by
+   * depth (a rest triangle a little nearer than the surface it lies on). */
   #drawSurface(proj) {
     const ctx = this.ctx;
     const { positions: p, normals: n, indices: idx, patchIds } = this.model;
@@ -137,17 +169,43 @@ export class View2D {
       const q = proj(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
       sx[i] = q[0]; sy[i] = q[1]; sd[i] = q[2];
     }
-    const nt = idx.length / 3;
-    const order = new Uint32Array(nt);
-    const depth = new Float32Array(nt);
+    const nt = this.layers.surface ? idx.length / 3 : 0;
+    const rest = this.layers.rest && this.rest ? this.rest : null;
+    const rp = rest ? rest.positions : [];
+    const nr = rp.length / 9;
+    const rx = new Float32Array(3 * nr), ry = new Float32Array(3 * nr), rd = new Float32Array(3 * nr);
+    for (let i = 0; i < 3 * nr; i++) {
+      const q = proj(rp[3 * i], rp[3 * i + 1], rp[3 * i + 2]);
+      rx[i] = q[0]; ry[i] = q[1]; rd[i] = q[2];
+    }
+    const order = new Uint32Array(nt + nr);
+    const depth = new Float32Array(nt + nr);
     for (let t = 0; t < nt; t++) {
       order[t] = t;
       depth[t] = sd[idx[3 * t]] + sd[idx[3 * t + 1]] + sd[idx[3 * t + 2]];
+    }
+    const bias = 3e-3 * this.radius;
+    for (let t = 0; t < nr; t++) {
+      order[nt + t] = nt + t;
+      depth[nt + t] = rd[3 * t] + rd[3 * t + 1] + rd[3 * t + 2] - bias;
     }
     order.sort((a, b) => depth[b] - depth[a]);
     const v = this.#viewDir();
     const light = normalize([v[0] + 0.3, v[1] - 0.2, v[2] + 0.6]);
     for (const t of order) {
+      if (t >= nt) {
+        const r = t - nt;
+        ctx.fillStyle = hexCss((REST_REASONS[rest.reasons[r]] || REST_REASONS[0]).colour);
+        ctx.globalAlpha = 0.85;
+        ctx.beginPath();
+        ctx.moveTo(rx[3 * r], ry[3 * r]);
+        ctx.lineTo(rx[3 * r + 1], ry[3 * r + 1]);
+        ctx.lineTo(rx[3 * r + 2], ry[3 * r + 2]);
+        ctx.closePath();
+        ctx.fill();
+        ctx.globalAlpha = 1;
+        continue;
+      }
       const a = idx[3 * t], b = idx[3 * t + 1], c = idx[3 * t + 2];
       const nrm = normalize([
         n[3 * a] + n[3 * b] + n[3 * c],
@@ -175,6 +233,19 @@ export class View2D {
       ctx.fill();
       ctx.strokeStyle = ctx.fillStyle;
       ctx.lineWidth = 0.5;
+      ctx.stroke();
+    }
+  }
+
+  /** A ring at each rest region, so that small ones are seen. */
+  #drawRestRings(proj) {
+    const ctx = this.ctx;
+    ctx.lineWidth = 2.5;
+    for (const r of this.rest.regions || []) {
+      const a = proj(...r.centre_mm);
+      ctx.strokeStyle = hexCss((REST_REASONS.find((x) => x.why === r.why) || REST_REASONS[0]).colour);
+      ctx.beginPath();
+      ctx.arc(a[0], a[1], 7, 0, 2 * Math.PI);
       ctx.stroke();
     }
   }

@@ -1,11 +1,12 @@
 // The 3D view with three.js (vendored in www/vendor/): shaded surface with patches in
-// colours (or the scallop heat map), extraordinary points, optional control mesh, the tool
-// path by patch with links and retractions drawn apart, and the tool (ball, shank, holder).
+// colours (or the scallop heat map), extraordinary points, optional control mesh, the rest
+// area a plan leaves (coloured by reason, with a ring at each region), the tool path by
+// patch with links and retractions drawn apart, and the tool (ball, shank, holder).
 // Z is up; lengths are millimetres. Renders on demand, not in a loop.
 import * as THREE from './vendor/three.module.js';
 import { OrbitControls } from './vendor/OrbitControls.js';
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, KINDS, PATCH_COLOURS, heatColour, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, pathColour,
 } from './colours.js';
 
 const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
@@ -28,7 +29,7 @@ export class View3D {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.screenSpacePanning = true;
     this.controls.addEventListener('change', () => this.render());
-    this.layers = { surface: true, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, path: true, tool: true, cage: false, eps: true };
     this.groups = {};
     for (const k of Object.keys(this.layers)) {
       this.groups[k] = new THREE.Group();
@@ -151,6 +152,57 @@ export class View3D {
     this.#colourSurface();
   }
 
+  /** The rest area: `positions` (Float32Array, xyz per vertex, 3 vertices per triangle, on
+   * the surface), `reasons` (Uint8Array, per triangle, an index of REST_REASONS) and
+   * `regions` ([{centre_mm, why}], a ring each, so that small regions are seen); null for
+   * none. Drawn over the surface, translucent. */
+  setRest(rest) {
+    this.#clear(this.groups.rest);
+    if (rest && rest.positions.length) {
+      const { positions: p, reasons } = rest;
+      const geom = new THREE.BufferGeometry();
+      geom.setAttribute('position', new THREE.BufferAttribute(new Float32Array(p), 3));
+      const col = new Float32Array(p.length);
+      const c = new THREE.Color();
+      for (let t = 0; t < reasons.length; t++) {
+        c.setHex((REST_REASONS[reasons[t]] || REST_REASONS[0]).colour);
+        for (let k = 0; k < 3; k++) col.set([c.r, c.g, c.b], 9 * t + 3 * k);
+      }
+      geom.setAttribute('color', new THREE.BufferAttribute(col, 3));
+      // In front of the surface (which is pushed back by its polygon offset), seen from
+      // both sides, letting the surface's shading show through a little.
+      const mat = new THREE.MeshBasicMaterial({
+        vertexColors: true, side: THREE.DoubleSide, transparent: true, opacity: 0.8,
+        depthWrite: false, polygonOffset: true, polygonOffsetFactor: -1, polygonOffsetUnits: -2,
+      });
+      const mesh = new THREE.Mesh(geom, mat);
+      mesh.renderOrder = 1;
+      this.groups.rest.add(mesh);
+    }
+    const regions = rest?.regions || [];
+    if (regions.length) {
+      const pos = new Float32Array(3 * regions.length);
+      const col = new Float32Array(3 * regions.length);
+      const c = new THREE.Color();
+      regions.forEach((r, i) => {
+        pos.set(r.centre_mm, 3 * i);
+        c.setHex((REST_REASONS.find((x) => x.why === r.why) || REST_REASONS[0]).colour);
+        col.set([c.r, c.g, c.b], 3 * i);
+      });
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+      g.setAttribute('color', new THREE.BufferAttribute(col, 3));
+      const mat = new THREE.PointsMaterial({
+        size: 16, sizeAttenuation: false, vertexColors: true, map: ringTexture(),
+        transparent: true, alphaTest: 0.3, depthWrite: false,
+      });
+      const rings = new THREE.Points(g, mat);
+      rings.renderOrder = 2;
+      this.groups.rest.add(rings);
+    }
+    this.render();
+  }
+
   /** The path: `cl` (Float64Array, ball centres), `kinds` (Uint8Array), `patchIds`. */
   setPath(path) {
     this.#clear(this.groups.path);
@@ -238,7 +290,7 @@ export class View3D {
     this.render();
   }
 
-  /** Shows or hides layers: `{surface, path, tool, cage, eps}`. */
+  /** Shows or hides layers: `{surface, rest, path, tool, cage, eps}`. */
   setLayers(layers) {
     Object.assign(this.layers, layers);
     this.render();
@@ -257,6 +309,26 @@ export class View3D {
     this.camera.updateProjectionMatrix();
     this.controls.update();
     this.render();
+  }
+
+  /** Frames a sphere of `radius` (mm) round `centre`, seen from direction `from` (a unit
+   * vector from the centre towards the viewer; the current direction if null). */
+  focus(centre, radius, from = null) {
+    const dir = from ? new THREE.Vector3(...from).normalize()
+      : this.camera.position.clone().sub(this.controls.target).normalize();
+    const dist = radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 1.05;
+    this.controls.target.set(...centre);
+    this.camera.position.copy(this.controls.target).addScaledVector(dir, dist);
+    this.camera.near = Math.max(dist / 1000, 1e-4);
+    this.camera.far = Math.max(dist, this.sceneRadius || 1) * 100;
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+    this.render();
+  }
+
+  /** The radius of the model's bounding sphere (mm). */
+  get modelRadius() {
+    return this.sceneRadius || 1;
   }
 
   /** Renders now and returns the frame's pixels, RGBA rows (for tests and diagnostics). */
@@ -332,4 +404,22 @@ export class View3D {
     this.controls.dispose();
     this.renderer.dispose();
   }
+}
+
+/** A white ring on transparent ground, for the rest-region markers (tinted per point). */
+let ring = null;
+function ringTexture() {
+  if (ring) return ring;
+  const n = 64;
+  const c = document.createElement('canvas');
+  c.width = n;
+  c.height = n;
+  const g = c.getContext('2d');
+  g.strokeStyle = '#fff';
+  g.lineWidth = n * 0.14;
+  g.beginPath();
+  g.arc(n / 2, n / 2, n * 0.36, 0, 2 * Math.PI);
+  g.stroke();
+  ring = new THREE.CanvasTexture(c);
+  return ring;
 }

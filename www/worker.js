@@ -20,6 +20,18 @@ function free(x) {
   return null;
 }
 
+/** Area of a triangle mesh (mm²): the drawn surface, within its chordal tolerance. */
+function meshArea(p, idx) {
+  let area = 0;
+  for (let t = 0; t < idx.length; t += 3) {
+    const a = 3 * idx[t], b = 3 * idx[t + 1], c = 3 * idx[t + 2];
+    const ux = p[b] - p[a], uy = p[b + 1] - p[a + 1], uz = p[b + 2] - p[a + 2];
+    const vx = p[c] - p[a], vy = p[c + 1] - p[a + 1], vz = p[c + 2] - p[a + 2];
+    area += Math.hypot(uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx) / 2;
+  }
+  return area;
+}
+
 /** Tessellation tolerance for drawing: 1/5000 of the diagonal, at least 5 µm (mm). */
 function drawChordal(summary) {
   const { min, max } = summary.bbox_mm;
@@ -44,6 +56,7 @@ const ops = {
       const result = {
         summary,
         chordal_mm: chordal,
+        area_mm2: meshArea(nextMesh.positions(), nextMesh.indices()),
         positions: nextMesh.positions(),
         normals: nextMesh.normals(),
         indices: nextMesh.indices(),
@@ -86,8 +99,10 @@ const ops = {
       axes: plan.axes(),
       kinds: plan.moveKinds(),
       patchIds: plan.patchIds(),
+      rest: plan.restPositions(),
+      restReasons: plan.restReasons(),
     };
-    const transfer = ['cl', 'cc', 'axes', 'kinds', 'patchIds'].map((k) => result[k].buffer);
+    const transfer = ['cl', 'cc', 'axes', 'kinds', 'patchIds', 'rest', 'restReasons'].map((k) => result[k].buffer);
     return { result, transfer };
   },
 
@@ -99,12 +114,15 @@ const ops = {
     return { result: { text, lines }, transfer: [lines.buffer] };
   },
 
-  /** Cutting simulation of the plan: summary and the heat map per drawn vertex. */
+  /** Cutting simulation of the plan (`options`: samples, bound_mm, max_samples): summary,
+   * the heat map per drawn vertex, and the plan's report with what it found. */
   async verify(options) {
     if (!plan) throw new Error('nothing is planned');
     const v = model.verify(plan, mesh, options);
     try {
-      const result = { summary: v.summary(), heat: v.heatMap(), verify_ms: v.verifyMs };
+      const result = {
+        summary: v.summary(), heat: v.heatMap(), verify_ms: v.verifyMs, report: plan.reportWith(v),
+      };
       return { result, transfer: [result.heat.buffer] };
     } finally {
       v.free();

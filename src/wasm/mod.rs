@@ -17,6 +17,14 @@ fn js_err(e: Error) -> JsError {
     JsError::new(&e.to_string())
 }
 
+/// A summary or report as a plain JavaScript object, with absent values (`None`) as `null`,
+/// as the CLI's JSON has them (not `undefined`).
+fn to_js<T: serde::Serialize>(value: &T) -> Result<JsValue, JsError> {
+    value
+        .serialize(&serde_wasm_bindgen::Serializer::new().serialize_missing_as_null(true))
+        .map_err(|e| JsError::new(&e.to_string()))
+}
+
 /// Milliseconds from the JavaScript clock (the only clock in a browser or Node).
 fn now_ms() -> f64 {
     #[cfg(target_arch = "wasm32")]
@@ -64,6 +72,14 @@ pub fn machine_json(name: &str) -> Result<String, JsError> {
         .map_err(js_err)
 }
 
+/// Most samples a plan's cutting simulation grows to while aiming for its error bound
+/// unless told otherwise (`max_samples` of `Model.verify`): the same cap as
+/// `tspath plan --verify` uses, so the page's default measures a plan as the CLI does.
+#[wasm_bindgen(js_name = planVerifyMaxSamples)]
+pub fn plan_verify_max_samples() -> f64 {
+    verify::PLAN_VERIFY_MAX_SAMPLES as f64
+}
+
 /// The crate version, for page footers and G-code headers.
 #[wasm_bindgen]
 pub fn version() -> String {
@@ -100,11 +116,11 @@ impl WasmModel {
         self.model.name.clone()
     }
 
-    /// Counts and bounding box: `{name, format, vertices, faces, control_points, t_junctions,
-    /// extraordinary_points, holes, patches, bbox_mm: {min, max}}`.
+    /// Counts and bounding box: `{name, format, units_read, vertices, faces, control_points,
+    /// t_junctions, extraordinary_points, holes, patches, bbox_mm: {min, max},
+    /// smallest_concave_radius: {radius_mm, at_mm} | null}` (mm).
     pub fn summary(&self) -> Result<JsValue, JsError> {
-        serde_wasm_bindgen::to_value(&self.model.summary())
-            .map_err(|e| JsError::new(&e.to_string()))
+        to_js(&self.model.summary())
     }
 
     /// Positions of the extraordinary points on the surface, `x y z` each (mm).
@@ -317,7 +333,7 @@ impl WasmPlan {
     /// `status` (`planned` or `planned_with_problems`), `unreachable_area_mm2`, `rest`
     /// (regions) and `problems` (each with `kind`, `message`, `at_mm` and `near_move`).
     pub fn report(&self) -> Result<JsValue, JsError> {
-        serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))
+        to_js(&self.report)
     }
 
     /// The report with what a cutting simulation of this plan found added to its problems
@@ -326,7 +342,7 @@ impl WasmPlan {
     pub fn report_with(&self, verification: &WasmVerification) -> Result<JsValue, JsError> {
         let mut r = self.report.clone();
         r.add_verification(&verification.summary);
-        serde_wasm_bindgen::to_value(&r).map_err(|e| JsError::new(&e.to_string()))
+        to_js(&r)
     }
 
     /// The rest area (what the plan leaves unmachined) as triangles on the surface: `x y z`
@@ -426,7 +442,6 @@ impl WasmPlan {
         Ok(js_sys::Uint32Array::from(&lines[..]))
     }
 }
-
 
 /// The `bound_mm` and `max_samples` fields of verify options, if given.
 fn bound_options(options: &JsValue) -> Result<(Option<f64>, usize), JsError> {
@@ -557,7 +572,7 @@ impl WasmVerification {
     /// unreached_fraction, max_gouge_mm, gouge_count, error_bound_mm, samples, ...,
     /// patches: [...]}` (all lengths in mm), as `tspath verify` prints it.
     pub fn summary(&self) -> Result<JsValue, JsError> {
-        serde_wasm_bindgen::to_value(&self.summary).map_err(|e| JsError::new(&e.to_string()))
+        to_js(&self.summary)
     }
 
     /// One value per vertex of the mesh passed to `verify`: the deepest gouge as a negative
