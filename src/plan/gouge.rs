@@ -9,7 +9,7 @@
 //! moves off the surface. Only creases are looked for: where other parts of a smooth surface
 //! come within the ball (thin walls) is not checked here.
 
-use super::{MoveKind, Toolpath};
+use super::{Move, MoveKind, Toolpath};
 use crate::error::{Error, Result};
 use crate::geom::{Aabb, Point3};
 use crate::model::Model;
@@ -29,10 +29,15 @@ pub struct GougeStats {
     /// `residual_mm`).
     pub residual: usize,
     pub residual_mm: f64,
+    /// Cut points added between two cut points where the ball, moving straight from one to
+    /// the other, cut into the surface (a fold or crease between them); they are lifted too.
+    pub inserted: usize,
 }
 
 /// Samples per face side for the nearest-point start.
 const START_SAMPLES: usize = 6;
+/// Samples of a face Newton starts from (the nearest ones).
+const NEAREST_STARTS: usize = 3;
 /// Newton steps of the nearest-point search on one face.
 const NEWTON_STEPS: usize = 30;
 /// Parameter step (of a face's unit square) below which the search has converged.
@@ -96,37 +101,65 @@ impl<'a> Nearest<'a> {
             if out > reach {
                 continue;
             }
-            let &(mut u, mut v, _) = self.starts[f]
-                .iter()
-                .min_by(|a, b| (a.2 - c).norm().total_cmp(&(b.2 - c).norm()))
-                .expect("samples");
-            for _ in 0..NEWTON_STEPS {
-                let d = self.surface.derivs(f, u, v);
-                let r = d.point - c;
-                let (a, b, cc) = (d.su.dot(&d.su), d.su.dot(&d.sv), d.sv.dot(&d.sv));
-                let (gu, gv) = (d.su.dot(&r), d.sv.dot(&r));
-                let det = a * cc - b * b;
-                if det.is_nan() || det <= 0.0 {
-                    break;
+            // Newton from the nearest few samples: on a tightly folded face the nearest
+            // sample may lie on the wrong side of the fold.
+            let mut starts: Vec<&(f64, f64, Point3)> = self.starts[f].iter().collect();
+            starts.sort_by(|a, b| (a.2 - c).norm().total_cmp(&(b.2 - c).norm()));
+            for &&(u, v, _) in starts.iter().take(NEAREST_STARTS) {
+                let (d, p) = self.descend(f, c, u, v);
+                match best {
+                    Some((bd, _)) if bd <= d => {}
+                    _ => best = Some((d, p)),
                 }
-                let (nu, nv) = (
-                    (u - (cc * gu - b * gv) / det).clamp(0.0, 1.0),
-                    (v - (a * gv - b * gu) / det).clamp(0.0, 1.0),
-                );
-                let moved = (nu - u).abs().max((nv - v).abs());
-                (u, v) = (nu, nv);
-                if moved < NEWTON_CONVERGED {
-                    break;
-                }
-            }
-            let p = self.surface.subs(f, u, v);
-            let d = (p - c).norm();
-            match best {
-                Some((bd, _)) if bd <= d => {}
-                _ => best = Some((d, p)),
             }
         }
         best
+    }
+
+    /// Local nearest point to `c` on face `f` from `(u, v)`: Newton steps on the squared
+    /// distance within the face's unit square; a coordinate that reaches the square's side
+    /// while the distance still falls outwards stays there and the other one goes on alone
+    /// (the nearest point then lies on that side of the face).
+    fn descend(&self, f: usize, c: &Point3, mut u: f64, mut v: f64) -> (f64, Point3) {
+        let mut fixed = [false, false];
+        for _ in 0..NEWTON_STEPS {
+            let d = self.surface.derivs(f, u, v);
+            let r = d.point - c;
+            let (gu, gv) = (d.su.dot(&r), d.sv.dot(&r));
+            // Gauss–Newton (the metric) plus the curvature terms where that stays positive.
+            let (mut a, mut b, mut cc) = (d.su.dot(&d.su), d.su.dot(&d.sv), d.sv.dot(&d.sv));
+            let (fa, fb, fc) = (a + d.suu.dot(&r), b + d.suv.dot(&r), cc + d.svv.dot(&r));
+            if fa > 0.0 && fc > 0.0 && fa * fc - fb * fb > 0.0 {
+                (a, b, cc) = (fa, fb, fc);
+            }
+            // A side the gradient pushes out of stays fixed.
+            for (k, (x, g)) in [(u, gu), (v, gv)].into_iter().enumerate() {
+                fixed[k] = (x <= 0.0 && g > 0.0) || (x >= 1.0 && g < 0.0);
+            }
+            let (du, dv) = match fixed {
+                [true, true] => break,
+                [true, false] => (0.0, if cc > 0.0 { -gv / cc } else { 0.0 }),
+                [false, true] => (if a > 0.0 { -gu / a } else { 0.0 }, 0.0),
+                [false, false] => {
+                    let det = a * cc - b * b;
+                    if det.is_nan() || det <= 0.0 {
+                        break;
+                    }
+                    (-(cc * gu - b * gv) / det, -(a * gv - b * gu) / det)
+                }
+            };
+            if !(du.is_finite() && dv.is_finite()) {
+                break;
+            }
+            let (nu, nv) = ((u + du).clamp(0.0, 1.0), (v + dv).clamp(0.0, 1.0));
+            let moved = (nu - u).abs().max((nv - v).abs());
+            (u, v) = (nu, nv);
+            if moved < NEWTON_CONVERGED {
+                break;
+            }
+        }
+        let p = self.surface.subs(f, u, v);
+        ((p - c).norm(), p)
     }
 }
 
@@ -155,7 +188,11 @@ const TIGHT_MARGIN: f64 = 0.25;
 /// more than `tol` mm, until it is a radius from the nearest surface point (within `tol`).
 /// The contact point becomes that nearest point; `left[i]` becomes the material the lifted
 /// ball leaves at move `i`'s old contact point (mm; untouched for moves not lifted).
-/// `keep_going` is asked every few hundred moves; false cancels.
+/// Then the straight moves next to lifted points, and those over which the ball turns round
+/// a convex crease, are checked between their ends: where the ball cuts in on the way, a lifted cut point is added half-way (and the halves checked
+/// again, [`SEGMENT_HALVINGS`] deep). Returns what it did and, when points were added, for
+/// every move of the new path the old move it is (`u32::MAX` for added ones; empty when
+/// nothing was added). `keep_going` is asked every few hundred moves; false cancels.
 pub fn lift(
     surface: &Surface,
     path: &mut Toolpath,
@@ -163,9 +200,10 @@ pub fn lift(
     tol: f64,
     left: &mut [f64],
     keep_going: &mut dyn FnMut() -> bool,
-) -> Result<GougeStats> {
+) -> Result<(GougeStats, Vec<u32>)> {
     let near = Nearest::new(surface);
     let mut stats = GougeStats::default();
+    let mut lifted = vec![false; path.moves.len()];
     for (i, m) in path.moves.iter_mut().enumerate() {
         if i % CANCEL_EVERY == 0 && !keep_going() {
             return Err(Error::Cancelled);
@@ -173,41 +211,155 @@ pub fn lift(
         if !matches!(m.kind, MoveKind::Feed | MoveKind::Link) {
             continue;
         }
-        let Some((d, q)) = near.nearest(&m.cl_point, r) else {
+        let Some(l) = lift_one(&near, m.cl_point, r, tol, &mut stats) else {
             continue;
         };
-        if d >= r - tol {
+        lifted[i] = true;
+        if let Some(x) = left.get_mut(i) {
+            *x = ((l.centre - m.cc_point).norm() - r).max(0.0);
+        }
+        m.cl_point = l.centre;
+        m.cc_point = l.contact;
+    }
+    // Straight moves next to lifted points.
+    let n = path.moves.len();
+    let near_lifted = |i: usize| {
+        (i.saturating_sub(SEGMENT_REACH)..(i + SEGMENT_REACH + 1).min(n)).any(|k| lifted[k])
+    };
+    let mut added: Vec<Vec<(Move, [f64; 2])>> = vec![Vec::new(); n];
+    for i in 1..n {
+        if i % CANCEL_EVERY == 0 && !keep_going() {
+            return Err(Error::Cancelled);
+        }
+        let (a, b) = (&path.moves[i - 1], &path.moves[i]);
+        if !(a.kind.on_surface() && matches!(b.kind, MoveKind::Feed | MoveKind::Link)) {
             continue;
         }
-        if r - d > stats.worst_mm {
-            stats.worst_mm = r - d;
-            stats.worst_at = Some(m.cl_point);
+        // The ball turning round a convex crease between the two points: its centre moves
+        // on an arc round the crease, the straight move cuts the chord of that arc.
+        let turn = (a.cl_point - a.cc_point).angle(&(b.cl_point - b.cc_point));
+        let pivots = r * (1.0 - (0.5 * turn).cos()) > tol;
+        if !(pivots || near_lifted(i)) {
+            continue;
         }
-        stats.lifted += 1;
-        let (mut c, mut nearest) = (m.cl_point, (d, q));
-        let mut depth = r - d;
-        for round in 0..LIFT_ROUNDS {
-            let (d, q) = nearest;
-            c += (c - q) / d * depth;
-            let Some(next) = near.nearest(&c, r) else {
-                break;
-            };
-            nearest = next;
-            depth = r - next.0;
-            if depth <= 0.1 * tol || round + 1 == LIFT_ROUNDS {
-                break;
-            }
-        }
-        let contact = nearest.1;
-        if depth > tol {
-            stats.residual += 1;
-            stats.residual_mm = stats.residual_mm.max(depth);
-        }
-        if let Some(l) = left.get_mut(i) {
-            *l = ((c - m.cc_point).norm() - r).max(0.0);
-        }
-        m.cl_point = c;
-        m.cc_point = contact;
+        let (pa, pb) = (
+            path.params.get(i - 1).copied().unwrap_or_default(),
+            path.params.get(i).copied().unwrap_or_default(),
+        );
+        let mut out = Vec::new();
+        split_segment(
+            &near,
+            (a, pa),
+            (b, pb),
+            r,
+            tol,
+            SEGMENT_HALVINGS,
+            &mut stats,
+            &mut out,
+        );
+        stats.inserted += out.len();
+        added[i] = out;
     }
-    Ok(stats)
+    if stats.inserted == 0 {
+        return Ok((stats, Vec::new()));
+    }
+    let mut origin = Vec::with_capacity(n + stats.inserted);
+    path.rebuild(|old, i, add| {
+        for (m, q) in &added[i] {
+            add(*m, *q);
+            origin.push(u32::MAX);
+        }
+        add(old.moves[i], old.param(i));
+        origin.push(i as u32);
+    });
+    Ok((stats, origin))
+}
+
+/// Moves on either side of a lifted point whose straight moves are checked between their ends.
+const SEGMENT_REACH: usize = 2;
+/// Most halvings of a straight move while adding lifted points on it.
+pub const SEGMENT_HALVINGS: usize = 6;
+/// Where between its ends a straight move is checked (fractions of it).
+const SEGMENT_PROBES: [f64; 3] = [0.5, 0.25, 0.75];
+
+/// A ball centre lifted clear of the surface, and the point it touches.
+struct Lifted {
+    centre: Point3,
+    contact: Point3,
+}
+
+/// Lifts the ball centred at `c` until it is a radius from the nearest surface point (within
+/// `tol`), if it cuts in by more than `tol`; `None` if it does not.
+fn lift_one(near: &Nearest, c: Point3, r: f64, tol: f64, stats: &mut GougeStats) -> Option<Lifted> {
+    let (d, q) = near.nearest(&c, r)?;
+    if d >= r - tol {
+        return None;
+    }
+    if r - d > stats.worst_mm {
+        stats.worst_mm = r - d;
+        stats.worst_at = Some(c);
+    }
+    stats.lifted += 1;
+    let (mut c, mut nearest) = (c, (d, q));
+    let mut depth = r - d;
+    for round in 0..LIFT_ROUNDS {
+        let (d, q) = nearest;
+        c += (c - q) / d * depth;
+        let Some(next) = near.nearest(&c, r) else {
+            break;
+        };
+        nearest = next;
+        depth = r - next.0;
+        if depth <= 0.1 * tol || round + 1 == LIFT_ROUNDS {
+            break;
+        }
+    }
+    if depth > tol {
+        stats.residual += 1;
+        stats.residual_mm = stats.residual_mm.max(depth);
+    }
+    Some(Lifted {
+        centre: c,
+        contact: nearest.1,
+    })
+}
+
+/// Adds to `out`, in order from `a` to `b`, lifted cut points where the ball moving straight
+/// from `a` to `b` cuts in by more than `tol`, checking the halves again up to `depth` deep.
+#[allow(clippy::too_many_arguments)]
+fn split_segment(
+    near: &Nearest,
+    a: (&Move, [f64; 2]),
+    b: (&Move, [f64; 2]),
+    r: f64,
+    tol: f64,
+    depth: usize,
+    stats: &mut GougeStats,
+    out: &mut Vec<(Move, [f64; 2])>,
+) {
+    if depth == 0 {
+        return;
+    }
+    let (ma, mb) = (a.0, b.0);
+    let cuts_in = SEGMENT_PROBES.iter().any(|&s| {
+        let c = ma.cl_point + (mb.cl_point - ma.cl_point) * s;
+        near.nearest(&c, r).is_some_and(|(d, _)| d < r - tol)
+    });
+    if !cuts_in {
+        return;
+    }
+    let mid = ma.cl_point + (mb.cl_point - ma.cl_point) * 0.5;
+    let (centre, contact) = match lift_one(near, mid, r, tol, stats) {
+        Some(l) => (l.centre, l.contact),
+        None => (mid, near.nearest(&mid, r).map_or(ma.cc_point, |(_, q)| q)),
+    };
+    let q = [0.5 * (a.1[0] + b.1[0]), 0.5 * (a.1[1] + b.1[1])];
+    let m = Move {
+        cl_point: centre,
+        cc_point: contact,
+        ..*mb
+    };
+    split_segment(near, a, (&m, q), r, tol, depth - 1, stats, out);
+    out.push((m, q));
+    split_segment(near, (&m, q), b, r, tol, depth - 1, stats, out);
 }

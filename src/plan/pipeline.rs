@@ -15,7 +15,7 @@
 use super::air::{self, AirStats, Routed};
 use super::axis::{self, AxisStats, Clearance};
 use super::distance::SurfaceDistance;
-use super::draft::Draft;
+use super::draft::{Draft, Footprint};
 use super::gouge::{self, GougeStats};
 use super::reach::{self, Rest, Why};
 use super::toolpath::{PlanReport, PlanStatus, Problem, Toolpath};
@@ -64,22 +64,43 @@ pub fn finish(
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Planned> {
     let r = opts.tool_radius_mm;
-    let n = draft.toolpath.moves.len();
-    // 1. Balls that cut into the surface away from their contact point are lifted clear;
-    //    what they then leave at the contact point is measured.
-    let mut left = vec![0.0; n];
+    // 1. Balls that cut into the surface away from their contact point are lifted clear
+    //    (and cut points added where straight moves between them would cut in); what they
+    //    then leave at the contact point is measured.
+    let mut left = vec![0.0; draft.toolpath.moves.len()];
     let gouge = if gouge::needed(model, r) {
-        gouge::lift(
+        let (stats, origin) = gouge::lift(
             &model.surface,
             &mut draft.toolpath,
             r,
             GOUGE_LIFT_SHARE * opts.overcut_mm(),
             &mut left,
             &mut || progress(0.1),
-        )?
+        )?;
+        if !origin.is_empty() {
+            let at = |o: u32| (o != u32::MAX).then_some(o as usize);
+            draft.footprints = origin
+                .iter()
+                .map(|&o| at(o).map_or(Footprint::NONE, |i| draft.footprints[i]))
+                .collect();
+            left = origin
+                .iter()
+                .map(|&o| at(o).map_or(0.0, |i| left[i]))
+                .collect();
+        }
+        stats
     } else {
         GougeStats::default()
     };
+    let n = draft.toolpath.moves.len();
+    // Where balls were lifted, the material left around them, measured.
+    let tight = reach::tight_near_lifts(
+        model,
+        &draft.toolpath,
+        &draft.footprints,
+        &left,
+        opts.scallop_mm,
+    );
     if !progress(0.15) {
         return Err(Error::Cancelled);
     }
@@ -129,11 +150,12 @@ pub fn finish(
     //    the scallop at their contact point.
     let footprints = (0..n)
         .filter_map(|i| {
-            let w = why[i].or((left[i] > opts.scallop_mm).then_some(Why::TooTight))?;
+            let w = why[i].or((left[i] > opts.scallop_mm || tight[i]).then_some(Why::TooTight))?;
             Some((draft.footprints[i], w))
         })
         .collect();
-    let rest = reach::rest(model, footprints, &path);
+    let halves = reach::cut_end_halves(&draft, &why);
+    let rest = reach::rest(model, footprints, halves, &path);
     let area = model_area(model);
     progress(1.0);
     Ok(Planned {
@@ -159,7 +181,7 @@ const AREA_SAMPLES: usize = 24;
 fn model_area(model: &Model) -> f64 {
     (0..model.layout.len())
         .map(|p| {
-            super::draft::Footprint {
+            Footprint {
                 patch: p as u32,
                 rect: [0.0, 1.0, 0.0, 1.0],
             }
@@ -235,6 +257,12 @@ impl Planned {
             r.notes.push(format!(
                 "at {} points the ball, placed by its own face's normal, cut into the surface elsewhere (a crease, or a concave radius below the ball's) by up to {:.4} mm, the deepest at ball centre ({:.3}, {:.3}, {:.3}) mm: they were lifted to touch it without cutting in",
                 self.gouge.lifted, self.gouge.worst_mm, p.x, p.y, p.z
+            ));
+        }
+        if self.gouge.inserted > 0 {
+            r.notes.push(format!(
+                "{} cut points added between cut points where the ball, moving straight, would have cut into a fold or crease of the surface",
+                self.gouge.inserted
             ));
         }
         if self.axes.tilted > 0 {
@@ -383,8 +411,14 @@ impl PlanReport {
             self.problems.push(Problem {
                 kind: "unproven".into(),
                 message: format!(
-                    "the simulation's error bound {:.4} mm is above the {:.4} mm (a quarter of the scallop) it aimed for with {} samples: the scallop and gouges are measured, not proven; simulate with more samples",
-                    v.error_bound_mm, target, v.samples
+                    "the simulation's error bound {} is above the {:.4} mm (a quarter of the scallop) it aimed for with {} samples: the scallop and gouges are measured, not proven; simulate with more samples",
+                    if v.error_bound_mm.is_finite() {
+                        format!("{:.4} mm", v.error_bound_mm)
+                    } else {
+                        "(not bounded: a ball only grazes the surface somewhere)".to_string()
+                    },
+                    target,
+                    v.samples
                 ),
                 count: 1,
                 at_mm: None,

@@ -14,6 +14,9 @@ use super::draft::{Draft, Footprint};
 use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
 use crate::geom::Point3;
 use crate::model::Model;
+use crate::verify::capsule::Capsule;
+use crate::verify::index::CapsuleIndex;
+use crate::verify::probe::{Material, Probe};
 use serde::{Deserialize, Serialize};
 
 /// Why a part of the surface is not machined.
@@ -51,7 +54,8 @@ pub struct RestRegion {
     pub why: Why,
     /// Its area (mm²).
     pub area_mm2: f64,
-    /// Its area-weighted middle (mm); may lie off a curved region.
+    /// A point of it on the surface (mm): the middle of its piece nearest its area-weighted
+    /// mean.
     pub centre_mm: [f64; 3],
     /// Cut points it stands for.
     pub points: usize,
@@ -193,6 +197,183 @@ fn split_runs(runs: &[PatchRun], moves: &[Move], origin: &[u32]) -> Vec<PatchRun
         .collect()
 }
 
+/// Samples per side of a footprint where the material left around lifted points is measured
+/// (corners and sides included) before the search for its highest point.
+const TIGHT_SAMPLES: usize = 5;
+/// Halvings of the pattern search for the highest material left in a footprint.
+const TIGHT_SEARCH_HALVINGS: usize = 10;
+/// Highest grid samples the pattern search starts from (peaks may be several).
+const TIGHT_SEARCH_STARTS: usize = 3;
+/// The pattern search's directions (steps in `u` and `v`).
+const PATTERN: [(f64, f64); 8] = [
+    (1.0, 0.0),
+    (-1.0, 0.0),
+    (0.0, 1.0),
+    (0.0, -1.0),
+    (1.0, 1.0),
+    (-1.0, -1.0),
+    (1.0, -1.0),
+    (-1.0, 1.0),
+];
+
+/// Which cut points leave more than `scallop_mm` in their footprint because balls were lifted
+/// near them: a ball lifted clear of a crease or a tight concave spot leaves more at its
+/// contact point (`left`) and widens the cusps to the passes beside it, which the side steps
+/// did not foresee. Every footprint touching a lifted point's is measured at a few points
+/// with the swept balls of `path` (the draft after lifting: the cuts as moves on the surface),
+/// as the cutting simulation measures them. Returns one flag per move.
+pub fn tight_near_lifts(
+    model: &Model,
+    path: &Toolpath,
+    footprints: &[Footprint],
+    left: &[f64],
+    scallop_mm: f64,
+) -> Vec<bool> {
+    let n = path.moves.len();
+    let mut tight = vec![false; n];
+    let r = path.tool_radius_mm;
+    let lifted: Vec<usize> = (0..n)
+        .filter(|&i| left.get(i).is_some_and(|&l| l > 0.0) && path.moves[i].kind.on_surface())
+        .collect();
+    if lifted.is_empty() {
+        return tight;
+    }
+    // How far a footprint reaches from its contact point (mm).
+    let extent = |i: usize| -> f64 {
+        let f = &footprints[i];
+        if f.is_none() {
+            return 0.0;
+        }
+        let p = &model.layout.patches[f.patch as usize];
+        let [u0, u1, v0, v1] = f.rect;
+        let c = path.moves[i].cc_point;
+        [(u0, v0), (u1, v0), (u0, v1), (u1, v1)]
+            .iter()
+            .map(|&(u, v)| (p.subs(&model.surface, u, v) - c).norm())
+            .fold(0.0, f64::max)
+    };
+    let lifted_extent: Vec<f64> = lifted.iter().map(|&i| extent(i)).collect();
+    let reach = 2.0 * lifted_extent.iter().fold(0.0f64, |a, &b| a.max(b)) + r;
+    // Candidates: cut points whose contact lies within reach of a lifted one (a hash grid of
+    // the lifted contacts), then those whose footprint may touch a lifted point's.
+    let cell = reach.max(1e-9);
+    let key = |p: &Point3| [p.x, p.y, p.z].map(|x| (x / cell).floor() as i64);
+    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
+    for (k, &i) in lifted.iter().enumerate() {
+        grid.entry(key(&path.moves[i].cc_point))
+            .or_default()
+            .push(k);
+    }
+    let mut candidates = Vec::new();
+    for (i, m) in path.moves.iter().enumerate() {
+        if !m.kind.on_surface() || footprints[i].is_none() {
+            continue;
+        }
+        let c = key(&m.cc_point);
+        let mut near = false;
+        'cells: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    if let Some(ks) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                        for &k in ks {
+                            let d = (path.moves[lifted[k]].cc_point - m.cc_point).norm();
+                            if d <= reach {
+                                near = true;
+                                break 'cells;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if near {
+            candidates.push(i);
+        }
+    }
+    // The swept balls near the candidates.
+    let mut region = crate::geom::Aabb::empty();
+    for &i in &candidates {
+        region.grow(&path.moves[i].cc_point);
+    }
+    let grow = reach + 2.0 * r;
+    let (lo, hi) = (region.min.map(|x| x - grow), region.max.map(|x| x + grow));
+    let inside = |p: &Point3| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]);
+    let capsules: Vec<Capsule> = path
+        .moves
+        .windows(2)
+        .filter(|w| w[1].kind.on_surface() && (inside(&w[0].cl_point) || inside(&w[1].cl_point)))
+        .map(|w| {
+            let a = if w[0].kind.on_surface() {
+                w[0].cl_point
+            } else {
+                w[1].cl_point
+            };
+            Capsule::new(a, w[1].cl_point)
+        })
+        .collect();
+    if capsules.is_empty() {
+        return tight;
+    }
+    let box_ = crate::geom::Aabb { min: lo, max: hi };
+    let index = CapsuleIndex::build(&capsules, r, &box_, 0.5 * r);
+    let mut probe = Probe::new(&capsules, &index, r, 2.0 * r, 2.0 * r);
+    let side = model.tool_side();
+    for i in candidates {
+        let f = footprints[i];
+        let p = &model.layout.patches[f.patch as usize];
+        let [u0, u1, v0, v1] = f.rect;
+        let mut left_at = |u: f64, v: f64| -> f64 {
+            let (u, v) = (u.clamp(u0, u1), v.clamp(v0, v1));
+            let Some(nrm) = p.normal(&model.surface, u, v) else {
+                return f64::NEG_INFINITY;
+            };
+            let q = p.subs(&model.surface, u, v);
+            match probe.measure(&q, &(nrm * side)) {
+                Material::Left { left_mm, .. } => left_mm,
+                Material::Unreached => f64::NEG_INFINITY,
+            }
+        };
+        // A grid, then a pattern search from its highest sample: where a crease meets the
+        // cusp between two passes the material left peaks sharply.
+        let k = (TIGHT_SAMPLES - 1) as f64;
+        let (du, dv) = ((u1 - u0) / k, (v1 - v0) / k);
+        let mut grid = Vec::with_capacity(TIGHT_SAMPLES * TIGHT_SAMPLES);
+        for a in 0..TIGHT_SAMPLES {
+            for b in 0..TIGHT_SAMPLES {
+                let (u, v) = (u0 + du * a as f64, v0 + dv * b as f64);
+                grid.push((left_at(u, v), u, v));
+            }
+        }
+        grid.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut top = grid[0].0;
+        for &start in grid.iter().take(TIGHT_SEARCH_STARTS) {
+            let mut best = start;
+            let (mut su, mut sv) = (0.5 * du, 0.5 * dv);
+            for _ in 0..TIGHT_SEARCH_HALVINGS {
+                if best.0 > scallop_mm {
+                    break;
+                }
+                let (_, u, v) = best;
+                for (a, b) in PATTERN {
+                    let (x, y) = ((u + a * su).clamp(u0, u1), (v + b * sv).clamp(v0, v1));
+                    let l = left_at(x, y);
+                    if l > best.0 {
+                        best = (l, x, y);
+                    }
+                }
+                (su, sv) = (0.5 * su, 0.5 * sv);
+            }
+            top = top.max(best.0);
+            if top > scallop_mm {
+                break;
+            }
+        }
+        let best = (top, 0.0, 0.0);
+        tight[i] = best.0 > scallop_mm;
+    }
+    tight
+}
+
 /// Relative size below which two footprint edges touch.
 const TOUCH_REL: f64 = 1e-9;
 
@@ -218,12 +399,82 @@ impl Sets {
     }
 }
 
-/// The rest area of `footprints` on `model`, its regions located against the final `path`.
-pub fn rest(model: &Model, footprints: Vec<(Footprint, Why)>, path: &Toolpath) -> Rest {
-    let fps: Vec<(Footprint, Why)> = footprints
+/// The parts of kept points' footprints the ball does not sweep. Where a cut stops because
+/// the next point along it is left out, the ball ends at the kept point, so the half of its
+/// footprint towards the left-out point (which the feed on to that point would have cut) is
+/// rest area too, with that point's reason: over it the ball's sphere alone leaves material
+/// growing with the distance from the point (head, three-axis, r 0.5 mm: 0.17 mm at the far
+/// corner of such a half, for a 0.05 mm scallop). `skip` has one entry per draft move.
+pub fn cut_end_halves(draft: &Draft, skip: &[Option<Why>]) -> Vec<(Footprint, Why)> {
+    let moves = &draft.toolpath.moves;
+    let params = &draft.toolpath.params;
+    if params.len() != moves.len() || skip.len() != moves.len() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for (i, m) in moves.iter().enumerate() {
+        let fp = draft.footprints[i];
+        if skip[i].is_some() || !m.kind.on_surface() || fp.is_none() {
+            continue;
+        }
+        for j in [i.wrapping_sub(1), i + 1] {
+            let (Some(n), Some(Some(why))) = (moves.get(j), skip.get(j)) else {
+                continue;
+            };
+            // Only the neighbour along the same pass (links between passes stand for no area).
+            if !n.kind.on_surface()
+                || n.patch != m.patch
+                || n.line != m.line
+                || draft.footprints[j].is_none()
+            {
+                continue;
+            }
+            let (p, q) = (params[i], params[j]);
+            let [u0, u1, v0, v1] = fp.rect;
+            let rect = if (q[0] - p[0]).abs() >= (q[1] - p[1]).abs() {
+                let pu = p[0].clamp(u0, u1);
+                if q[0] < p[0] {
+                    [u0, pu, v0, v1]
+                } else {
+                    [pu, u1, v0, v1]
+                }
+            } else {
+                let pv = p[1].clamp(v0, v1);
+                if q[1] < p[1] {
+                    [u0, u1, v0, pv]
+                } else {
+                    [u0, u1, pv, v1]
+                }
+            };
+            let half = Footprint {
+                patch: fp.patch,
+                rect,
+            };
+            if !half.is_none() {
+                out.push((half, *why));
+            }
+        }
+    }
+    out
+}
+
+/// The rest area of `footprints` (cut points left out, or kept but leaving too much) and of
+/// `halves` (parts of kept points' footprints, see [`cut_end_halves`]: area, but no cut
+/// points of their own) on `model`, its regions located against the final `path`.
+pub fn rest(
+    model: &Model,
+    footprints: Vec<(Footprint, Why)>,
+    halves: Vec<(Footprint, Why)>,
+    path: &Toolpath,
+) -> Rest {
+    let n_points = footprints.len();
+    let (fps, is_point): (Vec<(Footprint, Why)>, Vec<bool>) = footprints
         .into_iter()
-        .filter(|(f, _)| !f.is_none())
-        .collect();
+        .chain(halves)
+        .enumerate()
+        .filter(|(_, (f, _))| !f.is_none())
+        .map(|(k, fw)| (fw, k < n_points))
+        .unzip();
     let n = fps.len();
     let mut sets = Sets((0..n).collect());
     // Footprints of one patch and reason touching each other join: bucketed by patch and
@@ -263,31 +514,47 @@ pub fn rest(model: &Model, footprints: Vec<(Footprint, Why)>, path: &Toolpath) -
     let mut index_of_root: Vec<usize> = vec![usize::MAX; n];
     let mut acc: Vec<(u32, Why, f64, [f64; 3], usize)> = Vec::new();
     let mut total = 0.0;
+    let centres: Vec<Point3> = fps.iter().map(|(f, _)| f.centre(model)).collect();
+    let mut members: Vec<Vec<usize>> = Vec::new();
     for i in 0..n {
         let root = sets.find(i);
         if index_of_root[root] == usize::MAX {
             index_of_root[root] = acc.len();
             acc.push((fps[i].0.patch, fps[i].1, 0.0, [0.0; 3], 0));
+            members.push(Vec::new());
         }
+        members[index_of_root[root]].push(i);
         let a = fps[i].0.area_mm2(model);
-        let c = fps[i].0.centre(model);
+        let c = centres[i];
         let e = &mut acc[index_of_root[root]];
         e.2 += a;
         for (k, x) in [c.x, c.y, c.z].into_iter().enumerate() {
             e.3[k] += a * x;
         }
-        e.4 += 1;
+        e.4 += usize::from(is_point[i]);
         total += a;
     }
     let mut regions: Vec<RestRegion> = acc
         .into_iter()
-        .map(|(patch, why, area, sum, points)| {
-            let centre = if area > 0.0 {
+        .zip(&members)
+        .map(|((patch, why, area, sum, points), member)| {
+            let mean = Point3::from(if area > 0.0 {
                 sum.map(|s| s / area)
             } else {
                 [0.0; 3]
-            };
-            let c = Point3::from(centre);
+            });
+            // On the surface: the middle of the region's footprint nearest its mean (which
+            // may lie off a curved region, inside the part).
+            let c = member
+                .iter()
+                .map(|&k| centres[k])
+                .min_by(|a, b| {
+                    (a - mean)
+                        .norm_squared()
+                        .total_cmp(&(b - mean).norm_squared())
+                })
+                .unwrap_or(mean);
+            let centre = [c.x, c.y, c.z];
             let near_move = path
                 .moves
                 .iter()
@@ -405,7 +672,7 @@ mod tests {
             (Footprint::NONE, Why::ToolHits),
         ];
         let whole = fp(0.0, 1.0, 0.0, 1.0).area_mm2(&m);
-        let rest = rest(&m, fps, &Toolpath::default());
+        let rest = rest(&m, fps, Vec::new(), &Toolpath::default());
         assert_eq!(rest.regions.len(), 3);
         assert_eq!(rest.regions[0].points, 3);
         let sum: f64 = rest.regions.iter().map(|r| r.area_mm2).sum();

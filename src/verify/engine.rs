@@ -52,6 +52,11 @@ struct Sample {
     area_density: f64,
     /// Inside the plan's rest area (left for another tool).
     rest: bool,
+    /// How far the cut reaches past the surface here (mm, 0 where it does not): the depth
+    /// along the normal, but no more than the straight depth inside the swept volume
+    /// ([`Probe::straight_depth`]), so that a cut under the other side of a concave crease
+    /// is not read as a gouge here.
+    overcut_mm: f64,
 }
 
 /// Running totals of one band or patch.
@@ -234,6 +239,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
         singular,
         area_density,
         rest,
+        overcut_mm: 0.0,
     };
     let Some((d, g)) = geometry(face, u, v) else {
         return unmeasured(face.subs(u, v), true, 0.0);
@@ -283,6 +289,17 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
         singular: false,
         area_density,
         rest,
+        overcut_mm: overcut(probe, &d.point, &n, left_mm),
+    }
+}
+
+/// The overcut at a point of the surface whose material left along the tool-side normal `n`
+/// is `left_mm` (see [`Sample::overcut_mm`]).
+fn overcut(probe: &mut Probe, p: &Point3, n: &Vector3, left_mm: f64) -> f64 {
+    if left_mm >= 0.0 {
+        0.0
+    } else {
+        (-left_mm).min(probe.straight_depth(p, n))
     }
 }
 
@@ -293,8 +310,8 @@ fn heat_value(s: &Sample, tol: f64) -> f32 {
         f32::NAN
     } else if !s.corner.reached {
         f32::INFINITY
-    } else if -s.corner.left_mm > tol {
-        s.corner.left_mm as f32
+    } else if s.overcut_mm > tol {
+        -s.overcut_mm as f32
     } else {
         s.corner.left_mm.max(0.0) as f32
     }
@@ -356,13 +373,14 @@ fn band(
                 if left > h_req {
                     acc.uncut_area += w;
                 }
-                if -left > tol {
+                let cut_in = s.overcut_mm;
+                if cut_in > tol {
                     acc.gouges += 1;
                     acc.gouge_area += w;
                 }
-                acc.note_gouge(-left, Some(s.corner.point));
-                if left < 0.0 && deepest.is_none_or(|(d, ..)| left < d) {
-                    deepest = Some((left, at(i, nu), v));
+                acc.note_gouge(cut_in, Some(s.corner.point));
+                if cut_in > 0.0 && deepest.is_none_or(|(d, ..)| -cut_in < d) {
+                    deepest = Some((-cut_in, at(i, nu), v));
                 }
                 if s.rest {
                     // Left for another tool by the plan: not a scallop.
@@ -442,8 +460,10 @@ fn gouge_bottom(
     du: f64,
     dv: f64,
 ) -> (f64, Point3) {
-    let mut at = (u, v, measure(ctx, probe, fi, u, v).corner);
-    let mut best = at.2.left_mm;
+    let first = measure(ctx, probe, fi, u, v);
+    let mut best = -first.overcut_mm;
+    let mut best_at = first.corner.point;
+    let mut at = (u, v, first.corner);
     for _ in 0..GOUGE_NEWTON_STEPS {
         let c = &at.2;
         if !(c.reached && c.w_mm > 0.0) {
@@ -462,14 +482,17 @@ fn gouge_bottom(
             sv.clamp(-GOUGE_STEP_CELLS * dv, GOUGE_STEP_CELLS * dv),
         );
         let (nu, nv) = ((at.0 + su).clamp(0.0, 1.0), (at.1 + sv).clamp(0.0, 1.0));
-        let next = measure(ctx, probe, fi, nu, nv).corner;
-        if !(next.reached && next.left_mm < best) {
+        let next = measure(ctx, probe, fi, nu, nv);
+        if !(next.corner.reached && next.corner.left_mm < at.2.left_mm) {
             break;
         }
-        best = next.left_mm;
-        at = (nu, nv, next);
+        if -next.overcut_mm < best {
+            best = -next.overcut_mm;
+            best_at = next.corner.point;
+        }
+        at = (nu, nv, next.corner);
     }
-    (best, at.2.point)
+    (best, best_at)
 }
 
 /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other: the
@@ -695,10 +718,14 @@ pub(super) fn run(
         for (i, p, n) in h.unfilled() {
             let n = n * ctx.sigma;
             let value = match probe.measure(&p, &n) {
-                Material::Left { left_mm, .. } if -left_mm > opts.gouge_tolerance_mm => {
-                    left_mm as f32
+                Material::Left { left_mm, .. } => {
+                    let cut_in = overcut(&mut probe, &p, &n, left_mm);
+                    if cut_in > opts.gouge_tolerance_mm {
+                        -cut_in as f32
+                    } else {
+                        left_mm.max(0.0) as f32
+                    }
                 }
-                Material::Left { left_mm, .. } => left_mm.max(0.0) as f32,
                 Material::Unreached => f32::INFINITY,
             };
             h.set(i, worse(f32::NAN, value));

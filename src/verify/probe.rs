@@ -97,6 +97,18 @@ impl<'a> Probe<'a> {
         best.map(|(_, c)| c)
     }
 
+    /// How deep the point `p` lies inside the swept volume, measured straight (mm): the ball
+    /// radius less the distance from `p` to the nearest capsule's segment, 0 if outside every
+    /// capsule. For a point the line along the normal found swept, this is how far the cut
+    /// reaches past the surface there; along the normal itself a cut may look much deeper
+    /// near a concave crease, where the normal of one side runs inside the thin layer cut
+    /// under the other side.
+    pub fn straight_depth(&mut self, p: &Point3, n: &Vector3) -> f64 {
+        let r = self.radius;
+        self.nearest_centre(p, n, r)
+            .map_or(0.0, |c| (r - (c - p).norm()).max(0.0))
+    }
+
     /// The measurement `left_mm` decided by capsule `i` entered along `span`.
     fn left(&self, p: &Point3, n: &Vector3, i: u32, span: &Span) -> Material {
         Material::Left {
