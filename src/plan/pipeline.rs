@@ -340,7 +340,7 @@ impl Planned {
             r.problems.push(Problem {
                 kind: "turn_margin".into(),
                 message: format!(
-                    "at {} moves the shank or holder comes within the {:.2} mm safety margin of the model (and may touch it) while the tool axis turns between two cut points, the first ending at ball centre ({:.3}, {:.3}, {:.3}) mm: allow more tilt, use a longer shank or a smaller holder",
+                    "at {} moves the shank or holder comes within the {:.2} mm safety margin of the model (and may touch it) as the tool moves (and its axis turns) from one cut point to the next, the first such move ending at ball centre ({:.3}, {:.3}, {:.3}) mm: allow more tilt, use a longer shank or a smaller holder",
                     self.axes.sweep_hits, self.axes.margin_mm, p.x, p.y, p.z
                 ),
                 count: self.axes.sweep_hits,

@@ -1,0 +1,139 @@
+//! Independent clearance checks shared by the planner tests: dense samples of the surface
+//! (from a fine tessellation, without the planner's own obstacle index) and signed distances
+//! from them to the ball, shank and holder of a tool pose.
+#![allow(dead_code)]
+
+use tspath::geom::{Point3, Vector3};
+use tspath::plan::PlanOptions;
+use tspath::Model;
+
+/// Samples at most 0.3 mm apart on a tessellation within 0.01 mm of the surface: a cylinder
+/// of radius r can sink between them by 0.3² / 8r (0.011 mm for a 1 mm shank).
+pub fn dense_samples(m: &Model) -> Vec<Point3> {
+    let (chordal, spacing) = (0.01, 0.3);
+    let t = m.tessellate(chordal);
+    let vertex = |i: u32| {
+        let p = &t.positions[3 * i as usize..3 * i as usize + 3];
+        Point3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+    };
+    let mut samples = Vec::new();
+    for tri in t.indices.chunks(3) {
+        let (a, b, c) = (vertex(tri[0]), vertex(tri[1]), vertex(tri[2]));
+        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+        let n = (longest / spacing).ceil().max(1.0) as usize;
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                samples.push(a + (b - a) * u + (c - a) * v);
+            }
+        }
+    }
+    samples
+}
+
+/// Signed distance (mm, negative inside) from `p` to the solid cylinder of radius `rad`
+/// whose axis runs from `a` along the unit vector `dir` for `len`.
+pub fn cylinder_distance(p: &Point3, a: &Point3, dir: &Vector3, len: f64, rad: f64) -> f64 {
+    let d = p - a;
+    let t = d.dot(dir);
+    let radial = (d - dir * t).norm();
+    let out_axial = (-t).max(t - len).max(0.0);
+    let out_radial = (radial - rad).max(0.0);
+    if out_axial == 0.0 && out_radial == 0.0 {
+        -(rad - radial).min(t).min(len - t)
+    } else {
+        out_axial.hypot(out_radial)
+    }
+}
+
+/// Surface samples in a uniform grid of cubes, for "is any sample inside this cylinder".
+pub struct SampleGrid {
+    cell: f64,
+    cells: std::collections::HashMap<(i64, i64, i64), Vec<Point3>>,
+}
+
+impl SampleGrid {
+    pub fn new(samples: &[Point3], cell: f64) -> Self {
+        let mut cells: std::collections::HashMap<_, Vec<Point3>> = Default::default();
+        for p in samples {
+            cells.entry(Self::key(p, cell)).or_default().push(*p);
+        }
+        SampleGrid { cell, cells }
+    }
+
+    fn key(p: &Point3, cell: f64) -> (i64, i64, i64) {
+        let k = |x: f64| (x / cell).floor() as i64;
+        (k(p.x), k(p.y), k(p.z))
+    }
+
+    /// Least signed distance (mm) from a sample to the solid cylinder of radius `rad` around
+    /// the segment `a`–`b`: negative inside, `reach` when no sample is nearer than that.
+    pub fn clearance_to_cylinder(&self, a: &Point3, b: &Point3, rad: f64, reach: f64) -> f64 {
+        let axis = b - a;
+        let len = axis.norm();
+        let dir = axis / len;
+        let grow = rad + reach;
+        let lo = a.coords.inf(&b.coords).add_scalar(-grow);
+        let hi = a.coords.sup(&b.coords).add_scalar(grow);
+        let (k0, k1) = (
+            Self::key(&Point3::from(lo), self.cell),
+            Self::key(&Point3::from(hi), self.cell),
+        );
+        let mut least = reach;
+        for x in k0.0..=k1.0 {
+            for y in k0.1..=k1.1 {
+                for z in k0.2..=k1.2 {
+                    let Some(ps) = self.cells.get(&(x, y, z)) else {
+                        continue;
+                    };
+                    for p in ps {
+                        least = least.min(cylinder_distance(p, a, &dir, len, rad));
+                    }
+                }
+            }
+        }
+        least
+    }
+
+    /// Least distance (mm) from `c` to a sample, `reach` when none is nearer.
+    pub fn nearest(&self, c: &Point3, reach: f64) -> f64 {
+        let (k0, k1) = (
+            Self::key(&(c - Vector3::repeat(reach)), self.cell),
+            Self::key(&(c + Vector3::repeat(reach)), self.cell),
+        );
+        let mut least = reach;
+        for x in k0.0..=k1.0 {
+            for y in k0.1..=k1.1 {
+                for z in k0.2..=k1.2 {
+                    if let Some(ps) = self.cells.get(&(x, y, z)) {
+                        for p in ps {
+                            least = least.min((p - c).norm());
+                        }
+                    }
+                }
+            }
+        }
+        least
+    }
+}
+
+/// Least clearance (mm, negative inside) between the surface samples and the shank above the
+/// flutes or the holder of a tool with ball centre `c` and axis `axis`; `reach` when farther.
+pub fn tool_clearance(
+    grid: &SampleGrid,
+    o: &PlanOptions,
+    c: Point3,
+    axis: Vector3,
+    reach: f64,
+) -> f64 {
+    let (f, ls, lh) = (o.flute_length(), o.shank_length_mm, o.holder_length_mm);
+    let shank =
+        grid.clearance_to_cylinder(&(c + axis * f), &(c + axis * ls), o.shank_radius(), reach);
+    let holder = grid.clearance_to_cylinder(
+        &(c + axis * ls),
+        &(c + axis * (ls + lh)),
+        o.holder_radius_mm,
+        reach,
+    );
+    shank.min(holder)
+}
