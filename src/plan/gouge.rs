@@ -53,7 +53,13 @@ struct Nearest<'a> {
     surface: &'a Surface,
     boxes: Vec<Aabb>,
     starts: Vec<Vec<(f64, f64, Point3)>>,
+    /// The faces whose box meets each cell of a uniform grid (cells of `cell` mm).
+    cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
+    cell: f64,
 }
+
+/// Most grid cells one face's box may be listed in; larger boxes make the cells coarser.
+const CELLS_PER_FACE: f64 = 64.0;
 
 impl<'a> Nearest<'a> {
     fn new(surface: &'a Surface) -> Self {
@@ -84,17 +90,56 @@ impl<'a> Nearest<'a> {
             boxes.push(b);
             starts.push(s);
         }
+        // Cells about the size of a face's box, coarser if some boxes would span too many.
+        let sizes: Vec<f64> = boxes
+            .iter()
+            .map(|b| (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max))
+            .collect();
+        let mean = sizes.iter().sum::<f64>() / sizes.len().max(1) as f64;
+        let largest = sizes.iter().fold(0.0f64, |a, &b| a.max(b));
+        let cell = mean
+            .max(largest / CELLS_PER_FACE.cbrt())
+            .max(f64::MIN_POSITIVE);
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<u32>> = Default::default();
+        for (f, b) in boxes.iter().enumerate() {
+            let (lo, hi) = (cell_of(&b.min, cell), cell_of(&b.max, cell));
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        cells.entry([x, y, z]).or_default().push(f as u32);
+                    }
+                }
+            }
+        }
         Nearest {
             surface,
             boxes,
             starts,
+            cells,
+            cell,
         }
     }
 
     /// Nearest point to `c` on faces whose box comes within `reach` of it, and its distance.
     fn nearest(&self, c: &Point3, reach: f64) -> Option<(f64, Point3)> {
         let mut best: Option<(f64, Point3)> = None;
-        for (f, b) in self.boxes.iter().enumerate() {
+        let lo = cell_of(&[c.x - reach, c.y - reach, c.z - reach], self.cell);
+        let hi = cell_of(&[c.x + reach, c.y + reach, c.z + reach], self.cell);
+        let mut faces: Vec<u32> = Vec::new();
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    if let Some(fs) = self.cells.get(&[x, y, z]) {
+                        faces.extend_from_slice(fs);
+                    }
+                }
+            }
+        }
+        faces.sort_unstable();
+        faces.dedup();
+        for f in faces {
+            let f = f as usize;
+            let b = &self.boxes[f];
             let out = (0..3)
                 .map(|k| (b.min[k] - c[k]).max(c[k] - b.max[k]).max(0.0))
                 .fold(0.0f64, |a, x| a.hypot(x));
@@ -161,6 +206,11 @@ impl<'a> Nearest<'a> {
         let p = self.surface.subs(f, u, v);
         ((p - c).norm(), p)
     }
+}
+
+/// The grid cell holding `p` for cells of `cell` mm.
+fn cell_of(p: &[f64; 3], cell: f64) -> [i64; 3] {
+    p.map(|x| (x / cell).floor() as i64)
 }
 
 /// True if the surface may have C0 knot lines (creases): only repeated knots, that is zero

@@ -202,8 +202,13 @@ fn split_runs(runs: &[PatchRun], moves: &[Move], origin: &[u32]) -> Vec<PatchRun
 const TIGHT_SAMPLES: usize = 5;
 /// Halvings of the pattern search for the highest material left in a footprint.
 const TIGHT_SEARCH_HALVINGS: usize = 10;
-/// Highest grid samples the pattern search starts from (peaks may be several).
+/// Most grid peaks the pattern search starts from (peaks may be several).
 const TIGHT_SEARCH_STARTS: usize = 3;
+/// Grid peaks lower than this share of the scallop are not searched further: a peak of the
+/// material left is a cusp whose height its neighbourhood shows within a cell.
+const TIGHT_SEARCH_FROM: f64 = 0.6;
+/// Relative slack on whether two footprints' spheres meet (dimensionless).
+const TOUCH_SLACK: f64 = 0.05;
 /// The pattern search's directions (steps in `u` and `v`).
 const PATTERN: [(f64, f64); 8] = [
     (1.0, 0.0),
@@ -270,23 +275,29 @@ pub fn tight_near_lifts(
             continue;
         }
         let c = key(&m.cc_point);
-        let mut near = false;
-        'cells: for dx in -1..=1 {
+        // Lifted points whose contact is within reach, then whether the two footprints'
+        // spheres (round the contact points, through the far corners) meet.
+        let mut near: Vec<usize> = Vec::new();
+        for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
                     if let Some(ks) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
-                        for &k in ks {
-                            let d = (path.moves[lifted[k]].cc_point - m.cc_point).norm();
-                            if d <= reach {
-                                near = true;
-                                break 'cells;
-                            }
-                        }
+                        near.extend(ks.iter().copied().filter(|&k| {
+                            (path.moves[lifted[k]].cc_point - m.cc_point).norm() <= reach
+                        }));
                     }
                 }
             }
         }
-        if near {
+        if near.is_empty() {
+            continue;
+        }
+        let own = extent(i);
+        let touches = near.iter().any(|&k| {
+            (path.moves[lifted[k]].cc_point - m.cc_point).norm()
+                <= (own + lifted_extent[k]) * (1.0 + TOUCH_SLACK)
+        });
+        if touches {
             candidates.push(i);
         }
     }
@@ -344,9 +355,23 @@ pub fn tight_near_lifts(
                 grid.push((left_at(u, v), u, v));
             }
         }
-        grid.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let mut top = grid[0].0;
-        for &start in grid.iter().take(TIGHT_SEARCH_STARTS) {
+        // The search starts from the grid's local maxima high enough to matter, highest first.
+        let at_grid = |a: usize, b: usize| grid[a * TIGHT_SAMPLES + b].0;
+        let mut starts: Vec<(f64, f64, f64)> = Vec::new();
+        for a in 0..TIGHT_SAMPLES {
+            for b in 0..TIGHT_SAMPLES {
+                let x = at_grid(a, b);
+                let peak = (a.saturating_sub(1)..(a + 2).min(TIGHT_SAMPLES)).all(|p| {
+                    (b.saturating_sub(1)..(b + 2).min(TIGHT_SAMPLES)).all(|q| at_grid(p, q) <= x)
+                });
+                if peak && x > TIGHT_SEARCH_FROM * scallop_mm {
+                    starts.push(grid[a * TIGHT_SAMPLES + b]);
+                }
+            }
+        }
+        starts.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut top = grid.iter().map(|g| g.0).fold(f64::NEG_INFINITY, f64::max);
+        for &start in starts.iter().take(TIGHT_SEARCH_STARTS) {
             let mut best = start;
             let (mut su, mut sv) = (0.5 * du, 0.5 * dv);
             for _ in 0..TIGHT_SEARCH_HALVINGS {
@@ -368,8 +393,7 @@ pub fn tight_near_lifts(
                 break;
             }
         }
-        let best = (top, 0.0, 0.0);
-        tight[i] = best.0 > scallop_mm;
+        tight[i] = top > scallop_mm;
     }
     tight
 }
