@@ -106,12 +106,12 @@ fn gcode_from_plan_verifies_like_the_planned_path() {
         "--samples",
         "20000",
         "--bound",
-        "0.004",
+        "0.0015",
     ]))
     .unwrap();
     let b: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert!(
-        num(&b, "error_bound_mm") <= 0.004,
+        num(&b, "error_bound_mm") <= 0.0015,
         "{}",
         b["error_bound_mm"]
     );

@@ -75,12 +75,12 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     // report takes in what the simulation found.
     let bounded = js_sys::Object::new();
     js_sys::Reflect::set(&bounded, &"samples".into(), &20_000.into()).unwrap();
-    js_sys::Reflect::set(&bounded, &"bound_mm".into(), &0.0125.into()).unwrap();
+    js_sys::Reflect::set(&bounded, &"bound_mm".into(), &0.004.into()).unwrap();
     let b = model.verify(&plan, &mesh, bounded.into()).unwrap();
     let bs = b.summary().unwrap();
-    assert!(get(&bs, "error_bound_mm").as_f64().unwrap() <= 0.0125);
+    assert!(get(&bs, "error_bound_mm").as_f64().unwrap() <= 0.004);
     assert!(get(&bs, "samples").as_f64().unwrap() > 20_000.0);
-    assert_eq!(get(&bs, "error_bound_target_mm").as_f64(), Some(0.0125));
+    assert_eq!(get(&bs, "error_bound_target_mm").as_f64(), Some(0.004));
     let report = plan.report_with(&b).unwrap();
     assert_eq!(
         get(&report, "status").as_string().as_deref(),

@@ -63,6 +63,7 @@ const PROBLEM_KINDS = {
   rest_too_tight: 'Rest material: tighter than the ball',
   turn_margin: 'Turn within the safety margin',
   scallop: 'Scallop above the request',
+  scallop_predicted: 'Scallop above the request (predicted)',
   gouge: 'Gouge',
   unproven: 'Not proven by the simulation',
 };

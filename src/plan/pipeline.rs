@@ -350,7 +350,7 @@ impl Planned {
         }
         if r.max_predicted_scallop_mm > opts.scallop_mm * (1.0 + SCALLOP_SLACK) {
             r.problems.push(Problem {
-                kind: "scallop".into(),
+                kind: "scallop_predicted".into(),
                 message: format!(
                     "the passes leave cusps up to {:.4} mm (predicted), above the requested {} mm",
                     r.max_predicted_scallop_mm, opts.scallop_mm
@@ -371,9 +371,18 @@ const SCALLOP_SLACK: f64 = 1e-9;
 impl PlanReport {
     /// Adds what a cutting simulation of this plan found wrong to the problems (gouges,
     /// material above the requested scallop outside the rest area, an error bound too wide
-    /// to prove the scallop) and updates the status.
+    /// to prove the scallop) and updates the status. A simulation that proves the scallop
+    /// within the request drops the planner's own prediction of cusps above it.
     pub fn add_verification(&mut self, v: &Verification) {
         let h = v.requested_scallop_mm;
+        // A simulation that proves the scallop (its maximum within h, its error bound within
+        // the target) supersedes the planner's prediction.
+        let proven = v
+            .error_bound_target_mm
+            .is_some_and(|t| v.error_bound_mm <= t);
+        if proven && v.max_scallop_mm <= h * (1.0 + SCALLOP_SLACK) {
+            self.problems.retain(|p| p.kind != "scallop_predicted");
+        }
         let at = |p: Option<[f64; 3]>| {
             p.map(|c| format!(" at ({:.3}, {:.3}, {:.3}) mm", c[0], c[1], c[2]))
                 .unwrap_or_default()

@@ -2,7 +2,7 @@
 //! parallel natively, in a fixed order so that results do not depend on the thread count),
 //! cell bounds, and the summary.
 
-use super::bound::{cell_bound, second_derivative_bound, CellFrame, Corner};
+use super::bound::{cell_bound, second_derivative_bound, CellBound, CellFrame, Corner};
 use super::capsule::Capsule;
 use super::heatmap::{worse, HeatMap};
 use super::index::CapsuleIndex;
@@ -31,6 +31,11 @@ const BAND_ROWS: usize = 32;
 const PERCENTILE: f64 = 0.95;
 /// Newton steps towards the bottom of the deepest gouge of a band.
 const GOUGE_NEWTON_STEPS: usize = 6;
+/// Share of the requested scallop by which a cell's bound may exceed the highest material
+/// measured before the cell is sampled more finely ([`refined_bound`]).
+const REFINE_SHARE: f64 = 0.15;
+/// Most times a cell is split in four while refining its bound.
+const REFINE_DEPTH: usize = 4;
 /// Largest Newton step, in cells.
 const GOUGE_STEP_CELLS: f64 = 2.0;
 
@@ -418,9 +423,37 @@ fn band(
                     dv,
                     boundary: [j == 1, i + 2 == nu, j + 1 == nv, i == 0],
                 };
-                let b = cell_bound(&c, &frame, r, ctx.reach, best);
+                let mut b = cell_bound(&c, &frame, r, ctx.reach, best);
+                let in_rest = prev[i].rest || prev[i + 1].rest || row[i].rest || row[i + 1].rest;
+                // A cell whose bound would raise the error bound is sampled more finely
+                // (near extraordinary points and tight folds the metric and the curvature
+                // change too much across a cell for its corners to bound it).
+                let above = [
+                    acc.max_left.unwrap_or(0.0).max(0.0) + REFINE_SHARE * h_req,
+                    acc.max_gouge.max(0.0) + REFINE_SHARE * h_req,
+                ];
+                let loose_scallop =
+                    !in_rest && b.scallop_upper_mm > above[0] && b.scallop_upper_mm > best[0];
+                let loose_gouge = b.gouge_upper_mm > above[1] && b.gouge_upper_mm > best[1];
+                if loose_scallop || loose_gouge {
+                    let corners = [*c[0], *c[1], *c[2], *c[3]];
+                    let origin = (at(i, nu), at(j - 1, nv));
+                    if let Some(fine) = refined_bound(
+                        ctx,
+                        probe,
+                        fi,
+                        origin,
+                        &corners,
+                        &frame,
+                        above,
+                        REFINE_DEPTH,
+                        &mut acc,
+                    ) {
+                        b = fine;
+                    }
+                }
                 acc.gouge_upper = max_opt(acc.gouge_upper, Some(b.gouge_upper_mm));
-                if prev[i].rest || prev[i + 1].rest || row[i].rest || row[i + 1].rest {
+                if in_rest {
                     // Part of the cell is rest area: its material left is not a scallop.
                     continue;
                 }
@@ -446,6 +479,99 @@ fn band(
         acc.note_gouge(-bottom, Some(at));
     }
     acc
+}
+
+/// Bound of the cell with corner 0 at `origin` (face parameters), sides `frame.du` and
+/// `frame.dv`, from its four quarters, each bounded from its own corners (five new samples)
+/// and split again while its scallop or gouge bound stays above `above` (scallop, gouge), up
+/// to `depth` times. The new
+/// samples' material left counts towards the maximum. `None` where a new sample cannot be
+/// used (unreached, singular, in the rest area): the cell keeps its own bound.
+#[allow(clippy::too_many_arguments)]
+fn refined_bound(
+    ctx: &Ctx,
+    probe: &mut Probe,
+    fi: usize,
+    origin: (f64, f64),
+    c: &[Corner; 4],
+    frame: &CellFrame,
+    above: [f64; 2],
+    depth: usize,
+    acc: &mut Acc,
+) -> Option<CellBound> {
+    let (du, dv) = (0.5 * frame.du, 0.5 * frame.dv);
+    // A 3 × 3 grid: the old corners and five new samples.
+    let mut g: [[Option<Corner>; 3]; 3] = [[None; 3]; 3];
+    g[0][0] = Some(c[0]);
+    g[2][0] = Some(c[1]);
+    g[0][2] = Some(c[2]);
+    g[2][2] = Some(c[3]);
+    for (a, b) in [(1, 0), (0, 1), (1, 1), (2, 1), (1, 2)] {
+        let s = measure(
+            ctx,
+            probe,
+            fi,
+            (origin.0 + du * a as f64).min(1.0),
+            (origin.1 + dv * b as f64).min(1.0),
+        );
+        if !s.corner.reached || s.singular || s.rest {
+            return None;
+        }
+        acc.note_left(Some(s.corner.left_mm), Some(s.corner.point));
+        acc.note_gouge(s.overcut_mm, Some(s.corner.point));
+        acc.refined += 1;
+        g[a][b] = Some(s.corner);
+    }
+    let g = g.map(|col| col.map(|x| x.expect("all nine samples set")));
+    let mut out: Option<CellBound> = None;
+    for (a, b) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let corners = [g[a][b], g[a + 1][b], g[a][b + 1], g[a + 1][b + 1]];
+        let sub = CellFrame {
+            du,
+            dv,
+            boundary: [
+                b == 0 && frame.boundary[0],
+                a == 1 && frame.boundary[1],
+                b == 1 && frame.boundary[2],
+                a == 0 && frame.boundary[3],
+            ],
+        };
+        let refs = [&corners[0], &corners[1], &corners[2], &corners[3]];
+        let sub_origin = (origin.0 + du * a as f64, origin.1 + dv * b as f64);
+        let mut sb = cell_bound(&refs, &sub, ctx.radius, ctx.reach, [f64::NEG_INFINITY; 2]);
+        if (sb.scallop_upper_mm > above[0] || sb.gouge_upper_mm > above[1]) && depth > 1 {
+            if let Some(fine) = refined_bound(
+                ctx,
+                probe,
+                fi,
+                sub_origin,
+                &corners,
+                &sub,
+                above,
+                depth - 1,
+                acc,
+            ) {
+                sb = fine;
+            }
+        }
+        // The cusp the bound located, relative to the whole cell's corner 0.
+        let argmax = sb
+            .argmax
+            .map(|[x, y]| [x + du * a as f64, y + dv * b as f64]);
+        out = Some(match out {
+            None => CellBound { argmax, ..sb },
+            Some(o) => CellBound {
+                scallop_upper_mm: o.scallop_upper_mm.max(sb.scallop_upper_mm),
+                gouge_upper_mm: o.gouge_upper_mm.max(sb.gouge_upper_mm),
+                argmax: if sb.scallop_upper_mm > o.scallop_upper_mm {
+                    argmax
+                } else {
+                    o.argmax
+                },
+            },
+        });
+    }
+    out
 }
 
 /// From a gouged sample at `(u, v)`, Newton steps towards the bottom of the gouge (where
