@@ -207,6 +207,10 @@ const TIGHT_SEARCH_STARTS: usize = 3;
 /// Grid peaks lower than this share of the scallop are not searched further: a peak of the
 /// material left is a cusp whose height its neighbourhood shows within a cell.
 const TIGHT_SEARCH_FROM: f64 = 0.6;
+/// Samples along a footprint side on the patch boundary before refining the highest.
+const EDGE_SAMPLES: usize = 17;
+/// Golden-section steps refining the highest material along such a side.
+const EDGE_REFINE_STEPS: usize = 24;
 /// Relative slack on whether two footprints' spheres meet (dimensionless).
 const TOUCH_SLACK: f64 = 0.05;
 /// The pattern search's directions (steps in `u` and `v`).
@@ -391,6 +395,57 @@ pub fn tight_near_lifts(
             top = top.max(best.0);
             if top > scallop_mm {
                 break;
+            }
+        }
+        // Along the footprint's sides on the patch boundary (where pass ends meet a crease,
+        // the cusp between two lifted ends peaks within a sliver of the boundary line).
+        if top <= scallop_mm {
+            let sides = [
+                (u0 <= 0.0, (u0, v0), (u0, v1)),
+                (u1 >= 1.0, (u1, v0), (u1, v1)),
+                (v0 <= 0.0, (u0, v0), (u1, v0)),
+                (v1 >= 1.0, (u0, v1), (u1, v1)),
+            ];
+            for (on_boundary, a, b) in sides {
+                if !on_boundary || top > scallop_mm {
+                    continue;
+                }
+                let at_x = |x: f64| (a.0 + (b.0 - a.0) * x, a.1 + (b.1 - a.1) * x);
+                let n = EDGE_SAMPLES - 1;
+                let mut best = (f64::NEG_INFINITY, 0usize);
+                for k in 0..=n {
+                    let (u, v) = at_x(k as f64 / n as f64);
+                    let l = left_at(u, v);
+                    if l > best.0 {
+                        best = (l, k);
+                    }
+                }
+                // Golden-section search between the best sample's neighbours.
+                let (mut lo, mut hi) = (
+                    best.1.saturating_sub(1) as f64 / n as f64,
+                    (best.1 + 1).min(n) as f64 / n as f64,
+                );
+                let phi = 0.5 * (5f64.sqrt() - 1.0);
+                let f = |x: f64, left_at: &mut dyn FnMut(f64, f64) -> f64| {
+                    let (u, v) = at_x(x);
+                    left_at(u, v)
+                };
+                let (mut x1, mut x2) = (hi - phi * (hi - lo), lo + phi * (hi - lo));
+                let (mut f1, mut f2) = (f(x1, &mut left_at), f(x2, &mut left_at));
+                for _ in 0..EDGE_REFINE_STEPS {
+                    if f1 < f2 {
+                        lo = x1;
+                        (x1, f1) = (x2, f2);
+                        x2 = lo + phi * (hi - lo);
+                        f2 = f(x2, &mut left_at);
+                    } else {
+                        hi = x2;
+                        (x2, f2) = (x1, f1);
+                        x1 = hi - phi * (hi - lo);
+                        f1 = f(x1, &mut left_at);
+                    }
+                }
+                top = top.max(best.0).max(f1).max(f2);
             }
         }
         tight[i] = top > scallop_mm;
