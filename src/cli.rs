@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
-use crate::plan::{isoparametric, PlanOptions};
+use crate::plan::{self, PlanOptions, Strategy};
 use crate::verify::{self, CutterPath, VerifyOptions};
 use std::time::Instant;
 
@@ -13,7 +13,8 @@ const USAGE: &str = "usage:
   tspath sample --list
   tspath sample NAME -o FILE.json
   tspath export MODEL -o FILE.stl|FILE.obj [--chordal MM]
-  tspath plan MODEL [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
+  tspath plan MODEL [--strategy isoparametric|isfc] [--isfc-plain]
+              [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
@@ -255,8 +256,9 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
             "--holder",
             "--holder-length",
             "--max-tilt",
+            "--strategy",
         ],
-        &["--verify"],
+        &["--verify", "--isfc-plain"],
     )?;
     let [model] = a.positional[..] else {
         return Err(Error::Io(format!("plan takes one MODEL\n{USAGE}")));
@@ -318,8 +320,14 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
             "a three-axis machine cannot tilt the tool: drop --max-tilt/--lead/--tilt or choose a five-axis --machine".into(),
         ));
     }
+    if let Some(name) = a.value("--strategy") {
+        opts.strategy = Strategy::parse(name)?;
+    }
+    if a.has("--isfc-plain") {
+        opts.isfc_plain = true;
+    }
     let t0 = Instant::now();
-    let planned = isoparametric::plan(&m, &opts, &mut |_| true)?;
+    let planned = plan::plan(&m, &opts, &mut |_| true)?;
     let mut report = planned.report(&opts);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
     let rest = planned.rest_rects(&m);

@@ -104,6 +104,8 @@ pub struct Draft {
     pub safe_z: f64,
     /// Retractions the strategy could not avoid.
     pub forced_retractions: usize,
+    /// What the space-filling curve is made of (`isfc` only).
+    pub isfc: Option<super::isfc::IsfcStats>,
 }
 
 /// Builds a [`Draft`] move by move.
@@ -218,6 +220,7 @@ impl DraftBuilder {
             footprints: self.footprints,
             safe_z: self.safe_z,
             forced_retractions,
+            isfc: None,
         }
     }
 }

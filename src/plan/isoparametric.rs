@@ -185,7 +185,7 @@ impl StepProfile {
 const MIN_PARAM_STEP: f64 = 1e-9;
 
 /// Largest scallop predicted by eq. 5 over all adjacent passes.
-fn predicted(s: &dyn ParamSurface, dir: FeedDir, ws: &[f64], r: f64) -> f64 {
+pub(crate) fn predicted(s: &dyn ParamSurface, dir: FeedDir, ws: &[f64], r: f64) -> f64 {
     let mut sorted = ws.to_vec();
     sorted.sort_by(f64::total_cmp);
     sorted

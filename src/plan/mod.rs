@@ -10,6 +10,7 @@ pub mod corners;
 pub mod distance;
 pub mod draft;
 pub mod gouge;
+pub mod isfc;
 pub mod isoparametric;
 pub mod options;
 pub mod order;
@@ -18,6 +19,22 @@ pub mod reach;
 pub mod stepover;
 pub mod toolpath;
 
-pub use options::PlanOptions;
+pub use options::{PlanOptions, Strategy};
+
+use crate::error::Result;
+use crate::model::Model;
+
+/// Plans `model` with the strategy `opts.strategy` names, through the shared pipeline.
+/// `progress` receives the fraction done and returns `false` to cancel.
+pub fn plan(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<Planned> {
+    match opts.strategy {
+        Strategy::Isoparametric => isoparametric::plan(model, opts, progress),
+        Strategy::Isfc => isfc::plan(model, opts, progress),
+    }
+}
 pub use pipeline::Planned;
 pub use toolpath::{Move, MoveKind, PatchRun, PlanReport, PlanStatus, Problem, Toolpath};

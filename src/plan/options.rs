@@ -51,6 +51,59 @@ pub struct PlanOptions {
     /// Largest tilt of the tool axis from +Z the planner may use to clear the shank and
     /// holder (degrees). Default 60°; 0° plans three-axis (the axis stays +Z).
     pub max_tilt_deg: f64,
+    /// Which strategy decides what to cut. Default `isoparametric` (patch-ordered zig-zags,
+    /// Shang et al. 2020); `isfc`: one closed space-filling curve over the whole surface
+    /// (Gan et al. 2014).
+    pub strategy: Strategy,
+    /// `isfc` only: the plain space-filling curve, without the parity repair and the corner
+    /// compensation, to measure what they bring. Default false.
+    pub isfc_plain: bool,
+    /// `isfc` only: weight of the length change in a link's cost (eq. 9, per mm).
+    /// Default 1.
+    pub isfc_length_weight: f64,
+    /// `isfc` only: weight of the tool-axis change in a link's cost (eq. 9, per unit of
+    /// `‖ΔV‖`). Default 1.
+    pub isfc_axis_weight: f64,
+}
+
+/// The strategies: what to cut, in which order. The shared pipeline decides how.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Strategy {
+    /// Patch-ordered, non-retraction isoparametric zig-zags (Shang et al. 2020).
+    #[default]
+    Isoparametric,
+    /// Improved space-filling curve (Gan et al. 2014).
+    Isfc,
+}
+
+impl Strategy {
+    /// Every strategy, in the order the CLI and the page list them.
+    pub const ALL: [Strategy; 2] = [Strategy::Isoparametric, Strategy::Isfc];
+
+    /// Its name in options, the CLI and the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Isoparametric => "isoparametric",
+            Strategy::Isfc => "isfc",
+        }
+    }
+
+    /// The strategy called `name`; the error lists the names.
+    pub fn parse(name: &str) -> Result<Self> {
+        Strategy::ALL
+            .into_iter()
+            .find(|s| s.name() == name)
+            .ok_or_else(|| {
+                Error::param(
+                    "strategy",
+                    format!(
+                        "unknown strategy `{name}`; the strategies are {}",
+                        Strategy::ALL.map(|s| s.name()).join(", ")
+                    ),
+                )
+            })
+    }
 }
 
 impl Default for PlanOptions {
@@ -74,6 +127,10 @@ impl Default for PlanOptions {
             holder_radius_mm: 10.0,
             holder_length_mm: 40.0,
             max_tilt_deg: 60.0,
+            strategy: Strategy::Isoparametric,
+            isfc_plain: false,
+            isfc_length_weight: 1.0,
+            isfc_axis_weight: 1.0,
         }
     }
 }
@@ -123,6 +180,11 @@ impl PlanOptions {
     pub fn with_lead_tilt(mut self, lead_deg: f64, tilt_deg: f64) -> Self {
         self.lead_deg = lead_deg;
         self.tilt_deg = tilt_deg;
+        self
+    }
+    /// Sets the strategy.
+    pub fn with_strategy(mut self, strategy: Strategy) -> Self {
+        self.strategy = strategy;
         self
     }
     /// Sets the start and suggested finish patches.
@@ -210,6 +272,20 @@ impl PlanOptions {
                     self.holder_radius_mm,
                     self.shank_radius()
                 ),
+            ));
+        }
+        for (name, v) in [
+            ("isfc_length_weight", self.isfc_length_weight),
+            ("isfc_axis_weight", self.isfc_axis_weight),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::param(name, format!("must be a number ≥ 0, got {v}")));
+            }
+        }
+        if self.isfc_length_weight + self.isfc_axis_weight <= 0.0 {
+            return Err(Error::param(
+                "isfc_length_weight",
+                "the length and axis weights of a link's cost cannot both be 0",
             ));
         }
         if self.scallop_mm >= self.tool_radius_mm {

@@ -53,6 +53,8 @@ pub struct Planned {
     pub rest: Rest,
     /// Share of the model's area the rest area is (0 to 1).
     pub rest_fraction: f64,
+    /// What the space-filling curve is made of (`isfc` only).
+    pub isfc: Option<super::isfc::IsfcStats>,
 }
 
 /// Runs the pipeline on `draft`. `progress` receives the fraction of this part done and
@@ -159,6 +161,7 @@ pub fn finish(
     let area = model_area(model);
     progress(1.0);
     Ok(Planned {
+        isfc: draft.isfc,
         strategy: draft.strategy,
         toolpath: path,
         forced_retractions: draft.forced_retractions,
@@ -247,9 +250,37 @@ impl Planned {
         let mut r = self
             .toolpath
             .report(self.strategy, opts.feed_mm_min, opts.plunge_feed_mm_min);
+        if let Some(s) = &self.isfc {
+            r.grid = Some(super::toolpath::GridSize {
+                s_lines: s.s_lines,
+                t_lines: s.t_lines,
+                vertices: s.vertices,
+            });
+            r.cells = Some(s.cells);
+            r.tree_links = Some(s.tree_links);
+            r.repaired_cells = Some(s.repaired_cells);
+            r.compensated_corners = Some(s.compensated_corners);
+            r.notes.push(format!(
+                "space-filling curve: {} closed loop(s) through {} grid vertices in {} cells ({} tree links, {} across patch sides), starting at ({:.3}, {:.3}, {:.3}) mm; {} corners with a detour ({} needed to hold the scallop), {} cells repaired for parity",
+                s.loops, s.vertices, s.cells, s.tree_links, s.cross_patch_links,
+                s.start_mm[0], s.start_mm[1], s.start_mm[2],
+                s.compensated_corners, s.needed_corners, s.repaired_cells
+            ));
+            if s.floating_vertices > 0 {
+                r.notes.push(format!(
+                    "{} grid vertices belong to no cell (the plain curve's odd lines) and are not cut",
+                    s.floating_vertices
+                ));
+            }
+        }
         if self.forced_retractions > 0 {
             r.notes.push(format!(
-                "no patch order and transit corners avoid retractions on this layout: {} retraction(s) used",
+                "{}: {} retraction(s) used",
+                if self.isfc.is_some() {
+                    "the layout falls into parts no curve can join across a shared side"
+                } else {
+                    "no patch order and transit corners avoid retractions on this layout"
+                },
                 self.forced_retractions
             ));
         }

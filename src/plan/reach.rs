@@ -715,6 +715,7 @@ mod tests {
             footprints: vec![Footprint::NONE; n],
             safe_z: 10.0,
             forced_retractions: 0,
+            isfc: None,
         };
         let mut skip = vec![None; n];
         skip[4] = Some(Why::ToolHits);

@@ -124,6 +124,29 @@ pub struct PlanReport {
     pub rest: Vec<super::reach::RestRegion>,
     /// What the plan leaves undone or cannot promise; empty when it is done.
     pub problems: Vec<Problem>,
+    /// `isfc`: the grid's lines (`u = const`, `v = const`) and vertices over all patches.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<GridSize>,
+    /// `isfc`: 2 × 2 cells of grid vertices.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cells: Option<usize>,
+    /// `isfc`: links of the spanning tree over the cells.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tree_links: Option<usize>,
+    /// `isfc`: cells with a line the parity repair added.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repaired_cells: Option<usize>,
+    /// `isfc`: turns with a corner detour.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compensated_corners: Option<usize>,
+}
+
+/// Size of a space-filling curve's grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GridSize {
+    pub s_lines: usize,
+    pub t_lines: usize,
+    pub vertices: usize,
 }
 
 /// Whether a plan did everything asked of it.
@@ -242,6 +265,11 @@ impl Toolpath {
             unreachable_area_mm2: 0.0,
             rest: Vec::new(),
             problems: Vec::new(),
+            grid: None,
+            cells: None,
+            tree_links: None,
+            repaired_cells: None,
+            compensated_corners: None,
         };
         let mut patches: Vec<u32> = self.moves.iter().map(|m| m.patch).collect();
         patches.sort_unstable();

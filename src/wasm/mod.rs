@@ -8,7 +8,7 @@
 use crate::error::Error;
 use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
-use crate::plan::{isoparametric, PlanOptions, PlanReport, Toolpath};
+use crate::plan::{PlanOptions, PlanReport, Toolpath};
 use crate::surface::tessellate::Tessellation;
 use crate::verify::{self, CutterPath, RestRect, Verification, VerifyOptions};
 use wasm_bindgen::prelude::*;
@@ -216,7 +216,7 @@ impl WasmModel {
                 None => true,
             }
         };
-        let planned = isoparametric::plan(&self.model, &opts, &mut cb).map_err(js_err)?;
+        let planned = crate::plan::plan(&self.model, &opts, &mut cb).map_err(js_err)?;
         let mut report = planned.report(&opts);
         report.plan_ms = now_ms() - t0;
         let rest_rects = planned.rest_rects(&self.model);
