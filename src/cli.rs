@@ -16,6 +16,7 @@ const USAGE: &str = "usage:
   tspath plan MODEL [--strategy isoparametric|isfc] [--isfc-plain]
               [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
+              [--axis-preset vertical|gan2014]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [-o OUT.nc] [--report REPORT.json]
@@ -30,6 +31,8 @@ const USAGE: &str = "usage:
   tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
               [--scallop MM] [--gouge-tolerance MM] [--machine NAME|FILE.json] [--dialect NAME]
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
+--axis-preset gan2014 leads the tool 10° from the surface normal along the feed, as the
+space-filling-curve paper machined (five-axis machines); --lead/--tilt after it override.
 --machine is a built-in machine (default 3-axis) or a machine JSON file (start from
 `tspath machine NAME -o FILE.json`); --dialect is linuxcnc (default), linuxcnc-tcp, fanuc,
 heidenhain, siemens or plain; --units mm (default) or inch.
@@ -257,6 +260,7 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
             "--holder-length",
             "--max-tilt",
             "--strategy",
+            "--axis-preset",
         ],
         &["--verify", "--isfc-plain"],
     )?;
@@ -289,6 +293,15 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
     };
     opts.start_patch = patch("--start-patch")?;
     opts.finish_patch = patch("--finish-patch")?;
+    match a.value("--axis-preset") {
+        None | Some("vertical") => {}
+        Some("gan2014") => opts = opts.with_paper_axis(),
+        Some(other) => {
+            return Err(Error::Io(format!(
+                "--axis-preset: `{other}` is not a preset: vertical (the collision-free axis closest to +Z, the default) or gan2014 (10° lead from the surface normal, as in Gan et al. 2014)"
+            )))
+        }
+    }
     if let Some(v) = a.number("--lead")? {
         opts.lead_deg = v;
     }

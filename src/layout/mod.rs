@@ -680,6 +680,14 @@ impl Patch {
         out
     }
 
+    /// The surface face (index into [`Surface::faces`]) at patch parameters `(u, v)` and the
+    /// point's parameters in that face's unit square.
+    pub fn face_param(&self, surface: &Surface, u: f64, v: f64) -> (u32, [f64; 2]) {
+        let (p, [x, y]) = self.locate(u * self.width, v * self.height);
+        let face = &surface.faces()[p.face as usize];
+        (p.face, [x / face.width, y / face.height])
+    }
+
     /// Point at patch parameters `(u, v)`.
     pub fn subs(&self, surface: &Surface, u: f64, v: f64) -> Point3 {
         let (p, [x, y]) = self.locate(u * self.width, v * self.height);

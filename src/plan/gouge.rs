@@ -42,6 +42,9 @@ const NEAREST_STARTS: usize = 3;
 const NEWTON_STEPS: usize = 30;
 /// Parameter step (of a face's unit square) below which the search has converged.
 const NEWTON_CONVERGED: f64 = 1e-12;
+/// Most steps from one Bézier cell of a face into the next during one descent, besides
+/// the Newton steps.
+const MAX_CELL_CROSSINGS: usize = 16;
 /// Lifting rounds per CL point (each moves it away from the then nearest point).
 const LIFT_ROUNDS: usize = 8;
 /// Moves between two checks for cancellation.
@@ -161,25 +164,82 @@ impl<'a> Nearest<'a> {
         best
     }
 
+    /// As [`Nearest::nearest`], also searching from `hints` (face, parameters in its unit
+    /// square): the samples nearest `c` may lie in another valley of the distance than the
+    /// nearest point (a face folded or creased inside).
+    fn nearest_from(
+        &self,
+        c: &Point3,
+        reach: f64,
+        hints: &[(u32, [f64; 2])],
+    ) -> Option<(f64, Point3)> {
+        let mut best = self.nearest(c, reach);
+        for &(f, [u, v]) in hints {
+            let (d, p) = self.descend(f as usize, c, u, v);
+            if best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, p));
+            }
+        }
+        best
+    }
+
     /// Local nearest point to `c` on face `f` from `(u, v)`: Newton steps on the squared
-    /// distance within the face's unit square; a coordinate that reaches the square's side
-    /// while the distance still falls outwards stays there and the other one goes on alone
-    /// (the nearest point then lies on that side of the face).
+    /// distance within one Bézier cell of the face at a time. A coordinate that reaches a
+    /// side while the distance still falls outwards goes on into the next cell if the
+    /// distance falls that way there too; otherwise (the face's own side, or a crease the
+    /// distance has its kink on) it stays on the side and the other one goes on alone.
     fn descend(&self, f: usize, c: &Point3, mut u: f64, mut v: f64) -> (f64, Point3) {
-        let mut fixed = [false, false];
-        for _ in 0..NEWTON_STEPS {
-            let d = self.surface.derivs(f, u, v);
+        let face = &self.surface.faces()[f];
+        let breaks = face.breaks();
+        let breaks = [breaks.0, breaks.1];
+        let cell_of = |b: &[f64], x: f64| b[1..b.len() - 1].partition_point(|&k| k <= x);
+        let mut cell = [cell_of(breaks[0], u), cell_of(breaks[1], v)];
+        // The gradient of the squared distance from cell `k`.
+        let grad = |k: [usize; 2], u: f64, v: f64| {
+            let d = face.derivs_in(k, u, v);
             let r = d.point - c;
-            let (gu, gv) = (d.su.dot(&r), d.sv.dot(&r));
+            (d.su.dot(&r), d.sv.dot(&r), d, r)
+        };
+        let mut steps = 0;
+        while steps < NEWTON_STEPS + MAX_CELL_CROSSINGS {
+            steps += 1;
+            let (gu, gv, d, r) = grad(cell, u, v);
+            // A side the gradient pushes out of: the next cell's, or stay on it.
+            let mut fixed = [false, false];
+            let mut crossed = false;
+            for (k, (x, g)) in [(u, gu), (v, gv)].into_iter().enumerate() {
+                let b = breaks[k];
+                let (lo, hi) = (b[cell[k]], b[cell[k] + 1]);
+                let out = if x <= lo && g > 0.0 {
+                    (cell[k] > 0).then(|| cell[k] - 1)
+                } else if x >= hi && g < 0.0 {
+                    (cell[k] + 2 < b.len()).then(|| cell[k] + 1)
+                } else {
+                    continue;
+                };
+                let next = out.filter(|&n| {
+                    let mut nc = cell;
+                    nc[k] = n;
+                    let (nu, nv, _, _) = grad(nc, u, v);
+                    let gn = if k == 0 { nu } else { nv };
+                    gn * g > 0.0
+                });
+                match next {
+                    Some(n) => {
+                        cell[k] = n;
+                        crossed = true;
+                    }
+                    _ => fixed[k] = true,
+                }
+            }
+            if crossed {
+                continue;
+            }
             // Gauss–Newton (the metric) plus the curvature terms where that stays positive.
             let (mut a, mut b, mut cc) = (d.su.dot(&d.su), d.su.dot(&d.sv), d.sv.dot(&d.sv));
             let (fa, fb, fc) = (a + d.suu.dot(&r), b + d.suv.dot(&r), cc + d.svv.dot(&r));
             if fa > 0.0 && fc > 0.0 && fa * fc - fb * fb > 0.0 {
                 (a, b, cc) = (fa, fb, fc);
-            }
-            // A side the gradient pushes out of stays fixed.
-            for (k, (x, g)) in [(u, gu), (v, gv)].into_iter().enumerate() {
-                fixed[k] = (x <= 0.0 && g > 0.0) || (x >= 1.0 && g < 0.0);
             }
             let (du, dv) = match fixed {
                 [true, true] => break,
@@ -196,14 +256,16 @@ impl<'a> Nearest<'a> {
             if !(du.is_finite() && dv.is_finite()) {
                 break;
             }
-            let (nu, nv) = ((u + du).clamp(0.0, 1.0), (v + dv).clamp(0.0, 1.0));
+            let (bu, bv) = (breaks[0], breaks[1]);
+            let nu = (u + du).clamp(bu[cell[0]], bu[cell[0] + 1]);
+            let nv = (v + dv).clamp(bv[cell[1]], bv[cell[1] + 1]);
             let moved = (nu - u).abs().max((nv - v).abs());
             (u, v) = (nu, nv);
             if moved < NEWTON_CONVERGED {
                 break;
             }
         }
-        let p = self.surface.subs(f, u, v);
+        let p = face.derivs_in(cell, u, v).point;
         ((p - c).norm(), p)
     }
 }
@@ -244,14 +306,21 @@ const TIGHT_MARGIN: f64 = 0.25;
 /// every move of the new path the old move it is (`u32::MAX` for added ones; empty when
 /// nothing was added). `keep_going` is asked every few hundred moves; false cancels.
 pub fn lift(
-    surface: &Surface,
+    model: &Model,
     path: &mut Toolpath,
     r: f64,
     tol: f64,
     left: &mut [f64],
     keep_going: &mut dyn FnMut() -> bool,
 ) -> Result<(GougeStats, Vec<u32>)> {
-    let near = Nearest::new(surface);
+    let near = Nearest::new(&model.surface);
+    // Where a move's contact point is on the surface: the face and its parameters there.
+    let hint = |m: &Move, q: [f64; 2]| {
+        let patch = model.layout.patches.get(m.patch as usize)?;
+        m.kind
+            .on_surface()
+            .then(|| patch.face_param(&model.surface, q[0], q[1]))
+    };
     let mut stats = GougeStats::default();
     let mut lifted = vec![false; path.moves.len()];
     for (i, m) in path.moves.iter_mut().enumerate() {
@@ -261,7 +330,7 @@ pub fn lift(
         if !matches!(m.kind, MoveKind::Feed | MoveKind::Link) {
             continue;
         }
-        let Some(l) = lift_one(&near, m.cl_point, r, tol, &mut stats) else {
+        let Some(l) = lift_one(&near, m.cl_point, r, tol, &[], &mut stats) else {
             continue;
         };
         lifted[i] = true;
@@ -297,12 +366,14 @@ pub fn lift(
             path.params.get(i).copied().unwrap_or_default(),
         );
         let mut out = Vec::new();
+        let hints: Vec<(u32, [f64; 2])> =
+            [hint(a, pa), hint(b, pb)].into_iter().flatten().collect();
         split_segment(
             &near,
             (a, pa),
             (b, pb),
-            r,
-            tol,
+            (r, tol),
+            &hints,
             SEGMENT_HALVINGS,
             &mut stats,
             &mut out,
@@ -340,8 +411,15 @@ struct Lifted {
 
 /// Lifts the ball centred at `c` until it is a radius from the nearest surface point (within
 /// `tol`), if it cuts in by more than `tol`; `None` if it does not.
-fn lift_one(near: &Nearest, c: Point3, r: f64, tol: f64, stats: &mut GougeStats) -> Option<Lifted> {
-    let (d, q) = near.nearest(&c, r)?;
+fn lift_one(
+    near: &Nearest,
+    c: Point3,
+    r: f64,
+    tol: f64,
+    hints: &[(u32, [f64; 2])],
+    stats: &mut GougeStats,
+) -> Option<Lifted> {
+    let (d, q) = near.nearest_from(&c, r, hints)?;
     if d >= r - tol {
         return None;
     }
@@ -355,7 +433,7 @@ fn lift_one(near: &Nearest, c: Point3, r: f64, tol: f64, stats: &mut GougeStats)
     for round in 0..LIFT_ROUNDS {
         let (d, q) = nearest;
         c += (c - q) / d * depth;
-        let Some(next) = near.nearest(&c, r) else {
+        let Some(next) = near.nearest_from(&c, r, hints) else {
             break;
         };
         nearest = next;
@@ -381,8 +459,8 @@ fn split_segment(
     near: &Nearest,
     a: (&Move, [f64; 2]),
     b: (&Move, [f64; 2]),
-    r: f64,
-    tol: f64,
+    (r, tol): (f64, f64),
+    hints: &[(u32, [f64; 2])],
     depth: usize,
     stats: &mut GougeStats,
     out: &mut Vec<(Move, [f64; 2])>,
@@ -393,15 +471,20 @@ fn split_segment(
     let (ma, mb) = (a.0, b.0);
     let cuts_in = SEGMENT_PROBES.iter().any(|&s| {
         let c = ma.cl_point + (mb.cl_point - ma.cl_point) * s;
-        near.nearest(&c, r).is_some_and(|(d, _)| d < r - tol)
+        near.nearest_from(&c, r, hints)
+            .is_some_and(|(d, _)| d < r - tol)
     });
     if !cuts_in {
         return;
     }
     let mid = ma.cl_point + (mb.cl_point - ma.cl_point) * 0.5;
-    let (centre, contact) = match lift_one(near, mid, r, tol, stats) {
+    let (centre, contact) = match lift_one(near, mid, r, tol, hints, stats) {
         Some(l) => (l.centre, l.contact),
-        None => (mid, near.nearest(&mid, r).map_or(ma.cc_point, |(_, q)| q)),
+        None => (
+            mid,
+            near.nearest_from(&mid, r, hints)
+                .map_or(ma.cc_point, |(_, q)| q),
+        ),
     };
     let q = [0.5 * (a.1[0] + b.1[0]), 0.5 * (a.1[1] + b.1[1])];
     let m = Move {
@@ -409,7 +492,7 @@ fn split_segment(
         cc_point: contact,
         ..*mb
     };
-    split_segment(near, a, (&m, q), r, tol, depth - 1, stats, out);
+    split_segment(near, a, (&m, q), (r, tol), hints, depth - 1, stats, out);
     out.push((m, q));
-    split_segment(near, (&m, q), b, r, tol, depth - 1, stats, out);
+    split_segment(near, (&m, q), b, (r, tol), hints, depth - 1, stats, out);
 }

@@ -5,6 +5,10 @@ use super::corners::Crossfeed;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
+/// Lead of the tool axis from the surface normal in Gan et al. (2014), the `isfc` paper's
+/// machining tests (degrees).
+pub const PAPER_LEAD_DEG: f64 = 10.0;
+
 /// What the planner is asked for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -181,6 +185,12 @@ impl PlanOptions {
         self.lead_deg = lead_deg;
         self.tilt_deg = tilt_deg;
         self
+    }
+    /// The tool axis of Gan et al. (2014): inclined [`PAPER_LEAD_DEG`] from the surface
+    /// normal, forward along the feed (a five-axis machine; where that axis would collide,
+    /// the collision-free one closest to +Z as usual).
+    pub fn with_paper_axis(self) -> Self {
+        self.with_lead_tilt(PAPER_LEAD_DEG, 0.0)
     }
     /// Sets the strategy.
     pub fn with_strategy(mut self, strategy: Strategy) -> Self {

@@ -72,7 +72,7 @@ pub fn finish(
     let mut left = vec![0.0; draft.toolpath.moves.len()];
     let gouge = if gouge::needed(model, r) {
         let (stats, origin) = gouge::lift(
-            &model.surface,
+            model,
             &mut draft.toolpath,
             r,
             GOUGE_LIFT_SHARE * opts.overcut_mm(),

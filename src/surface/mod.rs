@@ -76,6 +76,44 @@ impl FaceSurface {
         }
     }
 
+    /// The lines `u = const` and `v = const` (from 0 to 1) between which the face is one
+    /// Bézier cell: only across these may it crease. A quadtree face (Catmull–Clark) is G1
+    /// everywhere and has none inside.
+    pub fn breaks(&self) -> (&[f64], &[f64]) {
+        const WHOLE: [f64; 2] = [0.0, 1.0];
+        match &self.form {
+            FaceForm::Grid {
+                u_breaks, v_breaks, ..
+            } => (u_breaks, v_breaks),
+            FaceForm::Tree(_) => (&WHOLE, &WHOLE),
+        }
+    }
+
+    /// As [`FaceSurface::derivs`], taken from the cell `cell` of [`FaceSurface::breaks`]
+    /// (`(u, v)` on its sides or inside): on a crease, the side of it that cell lies on.
+    pub fn derivs_in(&self, cell: [usize; 2], u: f64, v: f64) -> SurfaceDerivs {
+        match &self.form {
+            FaceForm::Grid {
+                u_breaks,
+                v_breaks,
+                cells,
+            } => {
+                let (i, j) = (
+                    cell[0].min(u_breaks.len() - 2),
+                    cell[1].min(v_breaks.len() - 2),
+                );
+                let (su, sv) = (
+                    1.0 / (u_breaks[i + 1] - u_breaks[i]),
+                    1.0 / (v_breaks[j + 1] - v_breaks[j]),
+                );
+                cells[j * (u_breaks.len() - 1) + i]
+                    .derivs((u - u_breaks[i]) * su, (v - v_breaks[j]) * sv)
+                    .scaled(su, sv)
+            }
+            FaceForm::Tree(node) => node.derivs(u, v),
+        }
+    }
+
     /// Point at `(u, v)` in `[0,1]²`.
     pub fn subs(&self, u: f64, v: f64) -> Point3 {
         match &self.form {

@@ -48,12 +48,21 @@ pub fn sample_plan(name: &str) -> Toolpath {
         .unwrap_or_else(|e| panic!("planning {name}: {e}"))
 }
 
-/// The planner's path on every sample (tool axis +Z).
+/// The planners' paths on every sample (tool axis +Z), and the space-filling curve's on two
+/// (a part with a hole and one with extraordinary points).
 pub fn sample_plans() -> Vec<(String, Toolpath)> {
-    samples::SAMPLES
+    let mut plans: Vec<(String, Toolpath)> = samples::SAMPLES
         .iter()
         .map(|s| (s.name.to_string(), sample_plan(s.name)))
-        .collect()
+        .collect();
+    for name in ["plate-hole", "keycap-convex"] {
+        let m = samples::load_sample(name).unwrap();
+        let o = opts_for(name).with_strategy(tspath::plan::Strategy::Isfc);
+        let p = tspath::plan::plan(&m, &o, &mut |_| true)
+            .unwrap_or_else(|e| panic!("planning {name} with isfc: {e}"));
+        plans.push((format!("{name}-isfc"), p.toolpath));
+    }
+    plans
 }
 
 /// Largest tilt of the test axes from +Z (degrees): a five-axis finishing path on a part

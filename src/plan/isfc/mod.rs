@@ -133,12 +133,11 @@ pub fn curve(
     let views = patch_views(model);
 
     // Sides a patch shares with another (0: v = 0, 1: u = 1, 2: v = 1, 3: u = 0).
+    let shared = shared_sides(model, &views)?;
     let mut free = vec![[true; 4]; np];
-    for c in &model.layout.connections {
-        if let (ConnectionKind::Boundary, Some((sa, sb))) = (c.kind, c.sides) {
-            free[c.a as usize][sa as usize] = false;
-            free[c.b as usize][sb as usize] = false;
-        }
+    for &(a, sa, b, sb) in &shared {
+        free[a as usize][sa as usize] = false;
+        free[b as usize][sb as usize] = false;
     }
 
     // 1. The grids and their vertices.
@@ -187,11 +186,8 @@ pub fn curve(
     };
     let mut links = cells::links_within(&grids, &cell_list, &first, &vertices, w);
     let within = links.len();
-    for c in &model.layout.connections {
-        let (ConnectionKind::Boundary, Some((sa, sb))) = (c.kind, c.sides) else {
-            continue;
-        };
-        let (a, b) = (c.a as usize, c.b as usize);
+    for &(a, sa, b, sb) in &shared {
+        let (a, b) = (a as usize, b as usize);
         let outer_a = cells::outer_cells(&grids[a], first[a], &cell_list, sa);
         let outer_b = cells::outer_cells(&grids[b], first[b], &cell_list, sb);
         links.extend(cells::links_across(&outer_a, &outer_b, &vertices, w));
@@ -239,7 +235,6 @@ pub fn curve(
         predicted_mm: worst,
     })
 }
-
 
 /// The patch views of `model`, seen from the side the tool works from.
 fn patch_views(model: &Model) -> Vec<PatchView<'_>> {
@@ -342,6 +337,99 @@ pub fn draft(
     let mut d = out.finish("isfc", Vec::new(), worst, forced);
     d.isfc = Some(stats);
     Ok(d)
+}
+
+/// Samples along a patch side, and golden-section steps after them, finding the point of
+/// the side facing a point of the neighbouring patch's side.
+const SIDE_SEARCH_SAMPLES: usize = 32;
+const SIDE_SEARCH_STEPS: usize = 40;
+
+/// Samples along a patch side deciding whether it lies on another patch's side.
+const SIDE_SAMPLES: usize = 9;
+/// Samples of the other side's curve it is compared with.
+const SIDE_CURVE_SAMPLES: usize = 64;
+/// Distance (as a share of the model's size) within which two sides coincide.
+const SIDE_MATCH_REL: f64 = 1e-6;
+
+/// The sides two patches share, as `(patch, side, patch, side)` (sides 0: `v = 0`,
+/// 1: `u = 1`, 2: `v = 1`, 3: `u = 0`): the layout's side connections, and sides that lie on
+/// each other in space although the layout has a strip of zero width between them (a
+/// crease's repeated knots), wholly or in part.
+fn shared_sides(model: &Model, views: &[PatchView]) -> Result<Vec<(u32, u8, u32, u8)>> {
+    let mut out: Vec<(u32, u8, u32, u8)> = model
+        .layout
+        .connections
+        .iter()
+        .filter_map(|c| match (c.kind, c.sides) {
+            (ConnectionKind::Boundary, Some((sa, sb))) => Some((c.a, sa, c.b, sb)),
+            _ => None,
+        })
+        .collect();
+    let bbox = model.surface.bbox();
+    let size = (0..3)
+        .map(|k| bbox.max[k] - bbox.min[k])
+        .fold(0.0, f64::max);
+    let tol = SIDE_MATCH_REL * size.max(1.0);
+    let side_at = |side: u8, t: f64| match side {
+        0 => [t, 0.0],
+        1 => [1.0, t],
+        2 => [t, 1.0],
+        _ => [0.0, t],
+    };
+    // Each side as a polyline.
+    let curves: Vec<[Vec<Point3>; 4]> = views
+        .iter()
+        .map(|v| {
+            [0u8, 1, 2, 3].map(|side| {
+                (0..=SIDE_CURVE_SAMPLES)
+                    .map(|k| {
+                        let [u, w] = side_at(side, k as f64 / SIDE_CURVE_SAMPLES as f64);
+                        v.subs(u, w)
+                    })
+                    .collect()
+            })
+        })
+        .collect();
+    let near_curve = |p: &Point3, c: &[Point3]| {
+        c.windows(2)
+            .map(|w| dist_to_segment(p, &w[0], &w[1]))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let np = views.len();
+    for a in 0..np {
+        for b in a + 1..np {
+            for sa in 0..4u8 {
+                for sb in 0..4u8 {
+                    if out.iter().any(|&(x, xs, y, ys)| {
+                        (x as usize, xs, y as usize, ys) == (a, sa, b, sb)
+                            || (x as usize, xs, y as usize, ys) == (b, sb, a, sa)
+                    }) {
+                        continue;
+                    }
+                    // Interior samples of a's side lying on b's side (the chords of b's
+                    // polyline are within a twentieth of a chord of it).
+                    let ca = &curves[a][sa as usize];
+                    let cb = &curves[b][sb as usize];
+                    let step = SIDE_CURVE_SAMPLES / (SIDE_SAMPLES + 1);
+                    let chord = ca
+                        .windows(2)
+                        .chain(cb.windows(2))
+                        .map(|w| (w[1] - w[0]).norm())
+                        .fold(0.0, f64::max);
+                    let on = (1..=SIDE_SAMPLES)
+                        .filter(|&k| near_curve(&ca[k * step], cb) <= tol + 0.05 * chord)
+                        .count();
+                    let back = (1..=SIDE_SAMPLES)
+                        .filter(|&k| near_curve(&cb[k * step], ca) <= tol + 0.05 * chord)
+                        .count();
+                    if on >= 2 && back >= 2 {
+                        out.push((a as u32, sa, b as u32, sb));
+                    }
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Cells with a corner on a line the parity repair added.
@@ -510,6 +598,16 @@ impl Ctx<'_> {
             &move |t| [x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t],
             Footprint::NONE,
         )?;
+        // The feet need not meet (the grids of the two patches differ): along the side
+        // from `a`'s foot to the point of it facing `b`'s, not straight across the surface.
+        let side_b = self.patch_point(vb.patch, fb)?.cc;
+        let (x, y) = (fa, self.along_side(va.patch, fa, &side_b)?);
+        self.emit_curve(
+            out,
+            va.patch,
+            &move |t| [x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t],
+            Footprint::NONE,
+        )?;
         let (x, y) = (fb, vb.uv);
         self.emit_curve(
             out,
@@ -532,6 +630,42 @@ impl Ctx<'_> {
             }
         }
         Ok(best.expect("four sides").1)
+    }
+
+    /// The point of the patch side `foot` lies on nearest `target`: samples along the side,
+    /// then golden-section steps between the nearest sample's neighbours.
+    fn along_side(&self, patch: u32, foot: [f64; 2], target: &Point3) -> Result<[f64; 2]> {
+        // The coordinate that runs along the side.
+        let k = usize::from(foot[1] != 0.0 && foot[1] != 1.0);
+        let at = |t: f64| {
+            let mut q = foot;
+            q[k] = t;
+            q
+        };
+        let dist =
+            |t: f64| -> Result<f64> { Ok((self.patch_point(patch, at(t))?.cc - target).norm()) };
+        let n = SIDE_SEARCH_SAMPLES;
+        let mut best = (f64::INFINITY, 0);
+        for i in 0..=n {
+            let d = dist(i as f64 / n as f64)?;
+            if d < best.0 {
+                best = (d, i);
+            }
+        }
+        let (mut lo, mut hi) = (
+            best.1.saturating_sub(1) as f64 / n as f64,
+            (best.1 + 1).min(n) as f64 / n as f64,
+        );
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..SIDE_SEARCH_STEPS {
+            let (a, b) = (hi - g * (hi - lo), lo + g * (hi - lo));
+            if dist(a)? < dist(b)? {
+                hi = b;
+            } else {
+                lo = a;
+            }
+        }
+        Ok(at(0.5 * (lo + hi)))
     }
 
     /// The detour at `q` if the curve turns there (coming from `g`, leaving to `h`, all of
