@@ -1,10 +1,12 @@
 //! Planning time of the keycap at the paper's settings (ball r = 0.5 mm, scallop 0.005 mm,
-//! chordal 0.001 mm, tool axis with collision checks). `cargo bench --bench plan`.
+//! chordal 0.001 mm, tool axis with collision checks): the patch-by-patch zig-zag's passes,
+//! the space-filling curve's (issue 14; target 150 ms for the convex keycap), and the whole
+//! plan of each (the shared pipeline included). `cargo bench --bench plan`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use tspath::model::samples;
-use tspath::plan::{isoparametric, PlanOptions};
+use tspath::plan::{self, isfc, isoparametric, PlanOptions, Strategy};
 
 fn bench_plan(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");
@@ -30,6 +32,42 @@ fn bench_plan(c: &mut Criterion) {
                 )
             })
         });
+    }
+    // The space-filling curve: its draft (grid, cells, tree, loop, corner detours, steps),
+    // and the whole plan with either strategy.
+    for name in ["keycap-convex", "keycap-concave"] {
+        let m = samples::load_sample(name).unwrap();
+        let curve = opts.clone().with_strategy(Strategy::Isfc);
+        let n = isfc::draft(&m, &curve, &mut |_| true)
+            .unwrap()
+            .toolpath
+            .moves
+            .len();
+        println!("{name}: space-filling curve {n} CL points");
+        group.bench_function(format!("{name} isfc draft"), |b| {
+            b.iter(|| {
+                black_box(
+                    isfc::draft(&m, &curve, &mut |_| true)
+                        .unwrap()
+                        .toolpath
+                        .moves
+                        .len(),
+                )
+            })
+        });
+        for (label, o) in [("isoparametric", &opts), ("isfc", &curve)] {
+            group.bench_function(format!("{name} whole plan {label}"), |b| {
+                b.iter(|| {
+                    black_box(
+                        plan::plan(&m, o, &mut |_| true)
+                            .unwrap()
+                            .toolpath
+                            .moves
+                            .len(),
+                    )
+                })
+            });
+        }
     }
     group.finish();
 }

@@ -41,6 +41,30 @@ for (const name of ['keycap-convex', 'keycap-concave']) {
   console.log(`plan ${name}: ${points} CL points in ${ms.toFixed(1)} ms`);
   m.free();
 }
+// The space-filling curve (issue 14): the convex keycap at the paper's settings (target
+// 400 ms) and mouse.tsm at r 1 mm, h 0.01 mm, three-axis (target 1 s), whole plans.
+{
+  const m = wasm.Model.sample('keycap-convex');
+  const opts = { tool_radius_mm: 0.5, scallop_mm: 0.005, chordal_mm: 0.001, strategy: 'isfc' };
+  let points = 0;
+  const ms = best(() => {
+    const p = m.plan(opts, null);
+    points = p.report().cl_points;
+    p.free();
+  }, 5);
+  console.log(`plan keycap-convex isfc: ${points} CL points in ${ms.toFixed(1)} ms (target ≤ 400 ms)`);
+  m.free();
+  const bytes = readFileSync(fileURLToPath(new URL('../www/models/grapetec/mouse.tsm', import.meta.url)));
+  const mouse = wasm.Model.fromBytes(bytes, 'mouse.tsm');
+  let report = null;
+  const mouseMs = best(() => {
+    const p = mouse.plan({ tool_radius_mm: 1, scallop_mm: 0.01, max_tilt_deg: 0, strategy: 'isfc' }, null);
+    report = p.report();
+    p.free();
+  }, 3);
+  console.log(`plan mouse.tsm isfc (three-axis, r 1 mm, h 0.01 mm): ${report.cl_points} CL points, ${report.retractions} retractions, ${report.length_mm.toFixed(0)} mm in ${mouseMs.toFixed(0)} ms (target ≤ 1000 ms)`);
+  mouse.free();
+}
 // The public .tsm files as a user opens them in the page: load, then plan three-axis.
 const models = fileURLToPath(new URL('../www/models/grapetec/', import.meta.url));
 for (const file of ['simple.tsm', 'mouse.tsm', 'face.tsm', 'fan.tsm', 'Bike.tsm', 'gearbox2-9.tsm']) {

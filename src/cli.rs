@@ -26,6 +26,10 @@ const USAGE: &str = "usage:
               the scallop
               exits with 3 after writing its outputs when the plan has problems (rest area,
               gouges, scallop over the request, an unproven simulation), listed on stderr
+  tspath compare MODEL [plan's options] [--verify [--verify-max-samples N]] [--markdown]
+              plans MODEL with both strategies; prints the area, the flat-surface bound
+              L_min = area / sqrt(8 r h) and each plan's lengths, retractions, time (and
+              with --verify the simulated scallop) as JSON or a Markdown table row
   tspath machine --list
   tspath machine NAME [-o FILE.json]
   tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
@@ -74,6 +78,7 @@ pub fn run_with_status(args: &[String]) -> Result<(String, Status)> {
         "info" => info(rest),
         "sample" => sample(rest),
         "verify" => verify_cmd(rest),
+        "compare" => compare_cmd(rest),
         "export" => export(rest),
         "machine" => machine_cmd(rest),
         "-h" | "--help" | "help" => Ok(USAGE.into()),
@@ -235,42 +240,41 @@ fn export(args: &[String]) -> Result<String> {
     ))
 }
 
-fn plan(args: &[String]) -> Result<(String, Status)> {
-    let a = parse(
-        args,
-        &[
-            "--tool-radius",
-            "--scallop",
-            "--chordal",
-            "--feed",
-            "-o",
-            "--report",
-            "--verify-samples",
-            "--verify-max-samples",
-            "--machine",
-            "--dialect",
-            "--units",
-            "--start-patch",
-            "--finish-patch",
-            "--lead",
-            "--tilt",
-            "--shank",
-            "--shank-length",
-            "--holder",
-            "--holder-length",
-            "--max-tilt",
-            "--strategy",
-            "--axis-preset",
-        ],
-        &["--verify", "--isfc-plain"],
-    )?;
+/// Options `plan` and `compare` take.
+const PLAN_FLAGS: &[&str] = &[
+    "--tool-radius",
+    "--scallop",
+    "--chordal",
+    "--feed",
+    "-o",
+    "--report",
+    "--verify-samples",
+    "--verify-max-samples",
+    "--machine",
+    "--dialect",
+    "--units",
+    "--start-patch",
+    "--finish-patch",
+    "--lead",
+    "--tilt",
+    "--shank",
+    "--shank-length",
+    "--holder",
+    "--holder-length",
+    "--max-tilt",
+    "--strategy",
+    "--axis-preset",
+];
+
+/// The model, machine and plan options of a `plan` or `compare` command line.
+fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     let [model] = a.positional[..] else {
-        return Err(Error::Io(format!("plan takes one MODEL\n{USAGE}")));
+        return Err(Error::Io(format!(
+            "plan and compare take one MODEL\n{USAGE}"
+        )));
     };
     let m = load_model(model)?;
     let mach = load_machine(a.value("--machine").unwrap_or("3-axis"))?;
-    let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
-    let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
     let mut opts = PlanOptions::default();
     if let Some(v) = a.number("--tool-radius")? {
         opts.tool_radius_mm = v;
@@ -339,6 +343,14 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
     if a.has("--isfc-plain") {
         opts.isfc_plain = true;
     }
+    Ok((m, mach, opts))
+}
+
+fn plan(args: &[String]) -> Result<(String, Status)> {
+    let a = parse(args, PLAN_FLAGS, &["--verify", "--isfc-plain"])?;
+    let (m, mach, opts) = plan_setup(&a)?;
+    let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
+    let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
     let t0 = Instant::now();
     let planned = plan::plan(&m, &opts, &mut |_| true)?;
     let mut report = planned.report(&opts);
@@ -402,6 +414,35 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
         Status::Problems(report.problems.iter().map(|p| p.message.clone()).collect())
     };
     Ok((out, status))
+}
+
+/// `compare`: both strategies on one model, as JSON or a Markdown table row.
+fn compare_cmd(args: &[String]) -> Result<String> {
+    let a = parse(
+        args,
+        PLAN_FLAGS,
+        &["--verify", "--isfc-plain", "--markdown"],
+    )?;
+    let (m, _, opts) = plan_setup(&a)?;
+    let max = if a.has("--verify") {
+        Some(
+            a.count("--verify-max-samples")?
+                .unwrap_or(verify::PLAN_VERIFY_MAX_SAMPLES),
+        )
+    } else {
+        None
+    };
+    let t0 = Instant::now();
+    let c = plan::compare::compare(&m, &opts, max, &|| t0.elapsed().as_secs_f64() * 1e3)?;
+    Ok(if a.has("--markdown") {
+        format!(
+            "{}\n{}\n",
+            plan::compare::Comparison::MARKDOWN_HEADER,
+            c.markdown_row(&m.name)
+        )
+    } else {
+        serde_json::to_string_pretty(&c).expect("comparison serialises") + "\n"
+    })
 }
 
 /// The error bound a plan's verification aims for, as a share of the scallop height: a

@@ -688,6 +688,19 @@ impl Patch {
         (p.face, [x / face.width, y / face.height])
     }
 
+    /// Point and unit normal (the face's, see [`crate::surface::FaceSurface::normal`]) at
+    /// patch parameters `(u, v)`, from one evaluation.
+    pub fn point_normal(
+        &self,
+        surface: &Surface,
+        u: f64,
+        v: f64,
+    ) -> (Point3, Option<crate::geom::Vector3>) {
+        let (p, [x, y]) = self.locate(u * self.width, v * self.height);
+        let face = &surface.faces()[p.face as usize];
+        face.point_normal(x / face.width, y / face.height)
+    }
+
     /// Point at patch parameters `(u, v)`.
     pub fn subs(&self, surface: &Surface, u: f64, v: f64) -> Point3 {
         let (p, [x, y]) = self.locate(u * self.width, v * self.height);

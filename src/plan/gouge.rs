@@ -151,9 +151,20 @@ impl<'a> Nearest<'a> {
             }
             // Newton from the nearest few samples: on a tightly folded face the nearest
             // sample may lie on the wrong side of the fold.
-            let mut starts: Vec<&(f64, f64, Point3)> = self.starts[f].iter().collect();
-            starts.sort_by(|a, b| (a.2 - c).norm().total_cmp(&(b.2 - c).norm()));
-            for &&(u, v, _) in starts.iter().take(NEAREST_STARTS) {
+            let mut starts = [(f64::INFINITY, 0.0, 0.0); NEAREST_STARTS];
+            for &(u, v, p) in &self.starts[f] {
+                let d = (p - c).norm_squared();
+                // Kept in order, nearest first (ties: the earlier sample).
+                if d < starts[NEAREST_STARTS - 1].0 {
+                    let at = starts.iter().position(|s| d < s.0).unwrap_or(0);
+                    starts.copy_within(at..NEAREST_STARTS - 1, at + 1);
+                    starts[at] = (d, u, v);
+                }
+            }
+            for &(d, u, v) in &starts {
+                if !d.is_finite() {
+                    break;
+                }
                 let (d, p) = self.descend(f, c, u, v);
                 match best {
                     Some((bd, _)) if bd <= d => {}

@@ -73,6 +73,14 @@ pub struct PatchView<'a> {
     pub side: f64,
 }
 
+impl PatchView<'_> {
+    /// Point and tool-side unit normal at `(u, v)`, from one evaluation.
+    pub fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
+        let (p, n) = self.patch.point_normal(self.surface, u, v);
+        (p, n.map(|n| n * self.side))
+    }
+}
+
 impl ParamSurface for PatchView<'_> {
     fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
         self.patch.derivs(self.surface, u, v)

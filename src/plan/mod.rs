@@ -6,6 +6,7 @@
 
 pub mod air;
 pub mod axis;
+pub mod compare;
 pub mod corners;
 pub mod distance;
 pub mod draft;

@@ -142,6 +142,16 @@ impl FaceSurface {
         })
     }
 
+    /// Point and unit normal at `(u, v)` from one evaluation (the normal as
+    /// [`FaceSurface::normal`] gives it).
+    pub fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
+        let d = self.derivs(u, v);
+        let n = DiffGeom::try_from_derivs(&d)
+            .map(|g| g.normal)
+            .or_else(|| self.normal(u, v));
+        (d.point, n)
+    }
+
     /// Number of Bézier cells.
     pub fn cell_count(&self) -> usize {
         match &self.form {

@@ -85,14 +85,16 @@ pub struct IsfcStats {
 const CHORD_SCALLOP_SHARE: f64 = 0.1;
 /// Part of the chordal tolerances the chords aim for (the chord is checked at a few points).
 const CHORD_MARGIN: f64 = 0.9;
-/// Fractions of a stretch where its chord is checked against the curve.
-const CHORD_PROBES: [f64; 3] = [0.5, 0.25, 0.75];
 /// Most halvings of a stretch while meeting the chordal tolerance.
 const CHORD_DEPTH: usize = 20;
 /// The check point's tolerance, as a share of the scallop (ε of the bisection).
 const CHECK_POINT_EPS: f64 = 0.01;
-/// Bisection steps locating the cusp between two balls.
+/// Most bisection steps locating the cusp between two balls.
 const CUSP_STEPS: usize = 30;
+/// The cusp's height is wanted to this share of the scallop: the bisection stops when the
+/// cusp's place is known well enough for that (the two balls' profiles cross there with
+/// slopes of about `d / 2r` for contacts `d` apart).
+const CUSP_HEIGHT_SHARE: f64 = 1e-3;
 /// Share of the progress bar the curve takes (the pipeline the rest).
 const DRAFT_SHARE: f64 = 0.6;
 
@@ -473,11 +475,12 @@ fn footprint(grids: &[PatchGrid], v: &Vertex) -> Footprint {
 /// Contact point and tool-side normal at patch parameters `uv`.
 fn point(view: &PatchView, uv: [f64; 2]) -> Result<(Point3, Vector3)> {
     let (u, v) = (uv[0].clamp(0.0, 1.0), uv[1].clamp(0.0, 1.0));
-    let n = view.normal(u, v).ok_or_else(|| Error::Degenerate {
+    let (p, n) = view.point_normal(u, v);
+    let n = n.ok_or_else(|| Error::Degenerate {
         location: format!("{} at (u, v) = ({u:.6}, {v:.6})", view.label()),
         message: "the surface has no tangent plane here or nearby".into(),
     })?;
-    Ok((view.subs(u, v), n))
+    Ok((p, n))
 }
 
 /// Material left (mm) along the unit normal `n` from `q` by a ball of radius `r` centred at
@@ -532,50 +535,60 @@ impl Ctx<'_> {
         last: Footprint,
     ) -> Result<()> {
         let at = |t: f64| self.patch_point(patch, curve(t));
-        let mut ts = vec![0.0, 1.0];
-        self.refine(&at, &mut ts, 0.0, 1.0, CHORD_DEPTH)?;
-        ts.sort_by(f64::total_cmp);
-        ts.dedup();
-        let n = ts.len();
-        for (k, &t) in ts.iter().enumerate().skip(1) {
-            let p = at(t)?;
-            out.feed(&p, 0, if k + 1 == n { last } else { Footprint::NONE });
+        let (pa, pb) = (at(0.0)?, at(1.0)?);
+        let mut points = Vec::new();
+        self.refine(&at, (0.0, &pa), (1.0, &pb), None, CHORD_DEPTH, &mut points)?;
+        points.push(pb);
+        let n = points.len();
+        for (k, p) in points.iter().enumerate() {
+            out.feed(p, 0, if k + 1 == n { last } else { Footprint::NONE });
         }
         Ok(())
     }
 
-    /// Adds to `ts` the parameters splitting `[a, b]` until every piece's chords are within
-    /// the limits (or `depth` halvings are used up).
+    /// Adds to `points`, in order, the points strictly between `a` and `b` splitting the
+    /// stretch until every piece's chords are within the limits (or `depth` halvings are
+    /// used up). `mid` is the middle point if known; every point evaluated is used.
     fn refine(
         &self,
         at: &dyn Fn(f64) -> Result<SurfacePoint>,
-        ts: &mut Vec<f64>,
-        a: f64,
-        b: f64,
+        (a, pa): (f64, &SurfacePoint),
+        (b, pb): (f64, &SurfacePoint),
+        mid: Option<SurfacePoint>,
         depth: usize,
+        points: &mut Vec<SurfacePoint>,
     ) -> Result<()> {
         if depth == 0 {
             return Ok(());
         }
-        let (pa, pb) = (at(a)?, at(b)?);
         let cl = |p: &SurfacePoint| p.cc + p.normal * self.r;
-        let mut fine = true;
-        for s in CHORD_PROBES {
-            let pm = at(a + (b - a) * s)?;
-            if dist_to_segment(&pm.cc, &pa.cc, &pb.cc) > self.chordal
-                || dist_to_segment(&cl(&pm), &cl(&pa), &cl(&pb)) > self.overcut
-            {
-                fine = false;
+        let off = |pm: &SurfacePoint| {
+            dist_to_segment(&pm.cc, &pa.cc, &pb.cc) > self.chordal
+                || dist_to_segment(&cl(pm), &cl(pa), &cl(pb)) > self.overcut
+        };
+        let m = 0.5 * (a + b);
+        let pm = match mid {
+            Some(p) => p,
+            None => at(m)?,
+        };
+        // The middle, then the quarters (kept as the halves' middles).
+        let mut quarters = [None, None];
+        let mut fine = !off(&pm);
+        for (k, s) in [0.25, 0.75].into_iter().enumerate() {
+            if !fine {
                 break;
             }
+            let q = at(a + (b - a) * s)?;
+            fine = !off(&q);
+            quarters[k] = Some(q);
         }
         if fine {
             return Ok(());
         }
-        let m = 0.5 * (a + b);
-        ts.push(m);
-        self.refine(at, ts, a, m, depth - 1)?;
-        self.refine(at, ts, m, b, depth - 1)
+        let [q1, q3] = quarters;
+        self.refine(at, (a, pa), (m, &pm), q1, depth - 1, points)?;
+        points.push(pm);
+        self.refine(at, (m, &pm), (b, pb), q3, depth - 1, points)
     }
 
     /// Moves from grid vertex `a` to grid vertex `b` (the tool is at `a`): along the grid
@@ -697,7 +710,7 @@ impl Ctx<'_> {
         let r = self.r;
         let mut failed: Option<Error> = None;
         let mut cusp = |x: [f64; 2], y: [f64; 2]| -> f64 {
-            match cusp_between(view, x, y, r) {
+            match cusp_between(view, x, y, r, CUSP_HEIGHT_SHARE * scallop) {
                 Ok(c) => c,
                 Err(e) => {
                     failed.get_or_insert(e);
@@ -722,11 +735,22 @@ impl Ctx<'_> {
 }
 
 /// The cusp (mm) between balls touching the surface at patch parameters `x` and `y`: the
-/// most material the two leave on the straight parameter line between them.
-pub fn cusp_between(view: &PatchView, x: [f64; 2], y: [f64; 2], r: f64) -> Result<f64> {
+/// most material the two leave on the straight parameter line between them, to within about
+/// `tol_mm`.
+pub fn cusp_between(
+    view: &PatchView,
+    x: [f64; 2],
+    y: [f64; 2],
+    r: f64,
+    tol_mm: f64,
+) -> Result<f64> {
     let (px, nx) = point(view, x)?;
     let (py, ny) = point(view, y)?;
     let (cx, cy) = (px + nx * r, py + ny * r);
+    // Bisect until the interval is shorter than `tol_mm` over the profiles' slope.
+    let d = (py - px).norm();
+    let slope = (d / (2.0 * r)).max(f64::EPSILON);
+    let enough = tol_mm / slope / d.max(f64::MIN_POSITIVE);
     let left = |s: f64| -> Result<(f64, f64)> {
         let (q, n) = point(view, [x[0] + (y[0] - x[0]) * s, x[1] + (y[1] - x[1]) * s])?;
         Ok((left_by_ball(&q, &n, &cx, r), left_by_ball(&q, &n, &cy, r)))
@@ -734,6 +758,9 @@ pub fn cusp_between(view: &PatchView, x: [f64; 2], y: [f64; 2], r: f64) -> Resul
     let (mut lo, mut hi) = (0.0, 1.0);
     let mut best: f64 = 0.0;
     for _ in 0..CUSP_STEPS {
+        if hi - lo < enough {
+            break;
+        }
         let mid = 0.5 * (lo + hi);
         let (a, b) = left(mid)?;
         let m = a.min(b);
