@@ -122,7 +122,7 @@ export function validate(raw, { patches = 1, fiveAxis = false } = {}) {
     for (const k of ['lead', 'tilt']) {
       if (fine(k) && v[k] !== 0 && !v['axis-preset']) errors[k] = `${byKey[k].label} needs a five-axis machine`;
     }
-    if (fine('axis-preset') && v['axis-preset']) errors['axis-preset'] = `${byKey['axis-preset'].label} needs a five-axis machine`;
+    if (fine('axis-preset') && v['axis-preset']) errors['axis-preset'] = `${byKey['axis-preset'].label} needs a five-axis machine: choose one, or set the preset to none`;
   }
   return { values, errors };
 }

@@ -741,7 +741,9 @@ export class TspathPlanner extends HTMLElement {
     for (const p of PARAMS.filter((q) => q.fiveAxis)) {
       const el = this.$(`p-${p.key}`);
       const byPreset = five && preset && (p.key === 'lead' || p.key === 'tilt');
-      el.disabled = !five || !!byPreset;
+      // A preset left on when the machine became three-axis stays changeable, to be undone.
+      const stuck = !five && p.key === 'axis-preset' && !!preset;
+      el.disabled = (!five && !stuck) || !!byPreset;
       el.title = !five ? 'Needs a five-axis machine: a three-axis machine keeps the tool axis at +Z'
         : byPreset ? `Set by the tool axis preset (${this.info?.paperLeadDeg ?? 10}° lead, 0° tilt)` : '';
     }

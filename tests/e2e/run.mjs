@@ -1042,6 +1042,35 @@ test('isfc: plate-hole in one pass; the report from wasm is the CLI\'s key by ke
     + `wasm = native on ${cmp.keys} report keys: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); plain curve: ${cmpPlain.exact} of ${cmpPlain.numbers} bit-equal; G-code = CLI; layer ${px} px`;
 });
 
+test('isfc with the gan2014 axis preset on a five-axis machine: the CLI\'s --axis-preset gan2014 plan', async (page, url) => {
+  await page.goto(`${url}?model=dome&strategy=isfc&tool-radius=1&scallop=0.05&machine=table-table-ac&axis-preset=gan2014&${SIM}`);
+  await page.waitForSelector(`${HOST}[data-model="dome"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
+  check(!(await page.isDisabled('#p-axis-preset')), 'the preset is offered on a five-axis machine');
+  for (const k of ['lead', 'tilt']) {
+    check(await page.isDisabled(`#p-${k}`) && /preset/.test(await page.getAttribute(`#p-${k}`, 'title')), `${k} is set by the preset, and says so`);
+  }
+  await page.uncheck('#auto');
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  const cli = cliPlan('dome', { toolRadius: 1, scallop: 0.05, machine: 'table-table-ac', extra: ['--strategy', 'isfc', '--axis-preset', 'gan2014'] });
+  const r = cli.report;
+  const cmp = compareReports(await host(page, (el) => el.plan.planReport), r, 'dome isfc gan2014');
+  check(r.max_axis_step_deg > 15, `the 10° lead turns with the feed (${r.max_axis_step_deg}°)`);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  check(g === cli.gcode, `the five-axis program is the CLI's (${g.length} vs ${cli.gcode.length} bytes)`);
+  // Without the preset the plan is another: stale; on a three-axis machine it is refused.
+  await setParam(page, 'axis-preset', '');
+  check(await page.$eval(HOST, (el) => el.hasAttribute('data-stale')) && !(await page.isDisabled('#p-lead')), 'no preset: stale, lead editable');
+  await setParam(page, 'axis-preset', 'gan2014');
+  check(!(await page.$eval(HOST, (el) => el.hasAttribute('data-stale'))), 'the preset again: the plan shown');
+  await setParam(page, 'machine', '3-axis');
+  check(/needs a five-axis machine/.test(await page.textContent('#p-axis-preset-error')) && await page.isDisabled('#plan'), 'three-axis: the preset is refused, with the reason');
+  await setParam(page, 'axis-preset', '');
+  check(await page.isDisabled('#p-axis-preset') && !(await page.isDisabled('#plan')), 'undone: three-axis plans again, the preset waits for five axes');
+  return `${r.cl_points} CL points, largest axis step ${r.max_axis_step_deg.toFixed(2)}°; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
+});
+
 test('a strategy that is not one is named, planning waits, and the page stays usable', async (page, url) => {
   await page.goto(`${url}?model=plate-hole&strategy=zigzag&tool-radius=1&scallop=0.05&${SIM}`);
   await waitState(page, 'model-loaded');
