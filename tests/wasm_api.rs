@@ -387,3 +387,115 @@ fn the_simulation_cap_is_the_clis() {
     );
     assert_eq!(tspath::wasm::plan_verify_max_samples(), 8_000_000.0);
 }
+
+/// Plan options as a JavaScript object.
+fn js_options(fields: &[(&str, JsValue)]) -> JsValue {
+    let o = js_sys::Object::new();
+    for (k, v) in fields {
+        js_sys::Reflect::set(&o, &JsValue::from_str(k), v).unwrap();
+    }
+    o.into()
+}
+
+#[wasm_bindgen_test]
+fn isfc_plans_one_pass_and_hands_over_its_cells_and_tree() {
+    // plate-hole: ten patches round a hole; the space-filling curve cuts it in one loop.
+    let model = Model::sample("plate-hole").unwrap();
+    let options = |plain: bool| {
+        js_options(&[
+            ("tool_radius_mm", 1.0.into()),
+            ("scallop_mm", 0.05.into()),
+            ("max_tilt_deg", 0.0.into()),
+            ("strategy", "isfc".into()),
+            ("isfc_plain", plain.into()),
+        ])
+    };
+    let plan = model.plan(options(false), None).unwrap();
+    let report = plan.report().unwrap();
+    let num = |k: &str| get(&report, k).as_f64().unwrap_or(f64::NAN);
+    assert_eq!(
+        get(&report, "strategy").as_string().as_deref(),
+        Some("isfc")
+    );
+    assert_eq!(num("retractions"), 0.0, "one pass, no retraction");
+    let cells = num("cells");
+    assert!(cells > 100.0, "{cells} cells");
+    assert_eq!(num("tree_links"), cells - 1.0, "a tree over every cell");
+    let grid = get(&report, "grid");
+    let vertices = get(&grid, "vertices").as_f64().unwrap();
+    assert_eq!(vertices, 4.0 * cells, "every grid vertex is in a cell");
+    assert!(get(&grid, "s_lines").as_f64().unwrap() >= 20.0);
+    assert!(get(&grid, "t_lines").as_f64().unwrap() >= 20.0);
+    assert!(num("compensated_corners") > 0.0);
+
+    // The layer: four segments per cell, one per tree link, in typed arrays.
+    let outline = plan.isfc_cells().unwrap().to_vec();
+    let tree = plan.isfc_tree().unwrap().to_vec();
+    let across = plan.isfc_tree_across().unwrap().to_vec();
+    assert_eq!(outline.len() as f64, 24.0 * cells);
+    assert_eq!(tree.len() as f64, 6.0 * (cells - 1.0));
+    assert_eq!(across.len() as f64, cells - 1.0);
+    let crossing = across.iter().filter(|&&a| a == 1).count();
+    assert!(
+        crossing >= 9 && across.iter().all(|&a| a <= 1),
+        "ten patches in one loop need at least nine links across sides ({crossing})"
+    );
+    // Each tree link ends at the centres of two cells (the mean of their corners).
+    let centres: Vec<[f64; 3]> = outline
+        .chunks(24)
+        .map(|c| {
+            let mut m = [0.0; 3];
+            for k in 0..4 {
+                for d in 0..3 {
+                    m[d] += f64::from(c[6 * k + d]) / 4.0;
+                }
+            }
+            m
+        })
+        .collect();
+    for (k, s) in tree.chunks(6).enumerate() {
+        for end in [&s[..3], &s[3..]] {
+            let at = centres.iter().any(|c| {
+                (0..3).all(|d| (c[d] - f64::from(end[d])).abs() < 1e-4 * c[d].abs().max(1.0))
+            });
+            assert!(at, "tree link {k} ends at {end:?}, no cell's centre");
+        }
+    }
+    // The start is in mm, as the report's note says it.
+    let start = plan.isfc_start().unwrap().to_vec();
+    assert_eq!(start.len(), 3);
+    let said = format!(
+        "starting at ({:.3}, {:.3}, {:.3}) mm",
+        start[0], start[1], start[2]
+    );
+    let notes = js_sys::Array::from(&get(&report, "notes"));
+    assert!(
+        notes.iter().any(|n| n.as_string().unwrap().contains(&said)),
+        "a note says {said}"
+    );
+
+    // The paper's plain curve: no parity repair, no corner detours.
+    let plain = model.plan(options(true), None).unwrap().report().unwrap();
+    assert_eq!(get(&plain, "repaired_cells").as_f64(), Some(0.0));
+    assert_eq!(get(&plain, "compensated_corners").as_f64(), Some(0.0));
+
+    // Zig-zags have no cells: the call says so instead of drawing nothing.
+    let zig = model
+        .plan(js_options(&[("scallop_mm", 0.05.into())]), None)
+        .unwrap();
+    assert!(get(&zig.report().unwrap(), "cells").is_undefined());
+    let msg = js_message(zig.isfc_cells().err().expect("isoparametric has no cells"));
+    assert!(
+        msg.contains("isoparametric") && msg.contains("isfc"),
+        "{msg}"
+    );
+    // A strategy that does not exist is named in the error with the ones that do.
+    let msg = js_message(
+        model
+            .plan(js_options(&[("strategy", "zigzag".into())]), None)
+            .err()
+            .expect("no such strategy"),
+    );
+    assert!(msg.contains("zigzag") && msg.contains("isfc"), "{msg}");
+    assert_eq!(tspath::wasm::paper_lead_deg(), 10.0);
+}

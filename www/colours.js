@@ -45,6 +45,10 @@ export function heatColour(v, scallopMm) {
 
 export const hexCss = (c) => `#${c.toString(16).padStart(6, '0')}`;
 
+/** The space-filling curve's layer: cell outlines, tree links within a patch and across a
+ * patch side. */
+export const ISFC_LAYER = { cell: 0x1f3b73, tree: 0xd81b60, across: 0xff8f00 };
+
 /** Why part of the surface is left as rest area, in the order of `Plan.restReasons()`
  * (0–3) and with the name the report's rest regions use (`why`). */
 export const REST_REASONS = [

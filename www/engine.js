@@ -20,6 +20,7 @@ export async function engineInfo() {
     machines: w.machineNames().map((name) => ({ name, json: w.machineJson(name) })),
     dialects: w.dialectNames(),
     verifyMaxSamples: w.planVerifyMaxSamples(),
+    paperLeadDeg: w.paperLeadDeg(),
   };
 }
 

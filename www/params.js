@@ -4,10 +4,16 @@
 
 /**
  * `key`: URL/attribute name; `field`: PlanOptions field (snake_case) or null for page-only
- * settings; `kind`: number | patch | choice; `default`: value when absent (null = the
- * engine's own default, said by `auto`).
+ * settings; `kind`: number | patch | choice | flag (a checkbox: `1` in the URL, or the bare
+ * attribute); `default`: value when absent (null = the engine's own default, said by `auto`).
+ * `fiveAxis`: only for machines that tilt the tool; `isfcOnly`: only for the space-filling
+ * curve.
  */
 export const PARAMS = [
+  // Strategy
+  { key: 'strategy', field: 'strategy', group: 'strategy', label: 'How the surface is cut', kind: 'choice', choices: [['isoparametric', 'Patch by patch (isoparametric)'], ['isfc', 'One continuous pass (space-filling curve)']], default: 'isoparametric' },
+  { key: 'isfc-plain', field: 'isfc_plain', group: 'strategy', label: 'Plain curve: the paper\u2019s baseline, without the parity repair and the corner compensation', kind: 'flag', default: false, isfcOnly: true },
+  { key: 'axis-preset', field: null, group: 'strategy', label: 'Tool axis preset', kind: 'choice', choices: [['', 'none: lead and tilt as set under Tool axis'], ['gan2014', 'Gan et al. 2014: 10\u00b0 lead from the surface normal']], default: '', fiveAxis: true },
   // Tool
   { key: 'tool-radius', field: 'tool_radius_mm', group: 'tool', label: 'Ball-end radius', unit: 'mm', kind: 'number', min: 0.05, max: 25, step: 0.05, default: 0.5 },
   { key: 'shank-radius', field: 'shank_radius_mm', group: 'tool', label: 'Shank radius', unit: 'mm', kind: 'number', min: 0.05, max: 50, step: 0.05, default: null, auto: 'ball radius' },
@@ -45,6 +51,7 @@ export const PARAMS = [
 
 export const GROUPS = [
   ['accuracy', 'Accuracy'],
+  ['strategy', 'Strategy'],
   ['tool', 'Tool, shank and holder'],
   ['output', 'Machine and program'],
   ['axis', 'Tool axis (five-axis machines)'],
@@ -88,6 +95,12 @@ export function validate(raw, { patches = 1, fiveAxis = false } = {}) {
         if (!Number.isInteger(v) || v < 0 || v >= patches) errors[p.key] = `${p.label} must be a patch from 0 to ${patches - 1}`;
         else values[p.key] = v;
       }
+    } else if (p.kind === 'flag') {
+      values[p.key] = s === '' ? p.default : flagOn(s);
+    } else if (s !== '' && p.choices.length && !p.choices.some(([c]) => c === s)) {
+      // A value from the URL or an attribute that is not one of the choices.
+      const named = p.choices.map(([c, text]) => (c ? c : text.replace(/:.*/, ''))).join(', ');
+      errors[p.key] = `${p.label}: \u201c${s}\u201d is not one of the choices (${named})`;
     } else {
       values[p.key] = s === '' ? p.default : s;
     }
@@ -107,20 +120,34 @@ export function validate(raw, { patches = 1, fiveAxis = false } = {}) {
   }
   if (!fiveAxis) {
     for (const k of ['lead', 'tilt']) {
-      if (fine(k) && v[k] !== 0) errors[k] = `${byKey[k].label} needs a five-axis machine`;
+      if (fine(k) && v[k] !== 0 && !v['axis-preset']) errors[k] = `${byKey[k].label} needs a five-axis machine`;
     }
+    if (fine('axis-preset') && v['axis-preset']) errors['axis-preset'] = `${byKey['axis-preset'].label} needs a five-axis machine: choose one, or set the preset to none`;
   }
   return { values, errors };
 }
 
-/** PlanOptions for the engine from validated values (a three-axis machine keeps +Z). */
-export function planOptions(values, { fiveAxis }) {
+/** A flag's text (URL, attribute, checkbox) as on or off: anything but 0/false/no/off is on,
+ * the bare attribute included. */
+export function flagOn(s) {
+  return !['0', 'false', 'no', 'off'].includes(String(s).trim().toLowerCase());
+}
+
+/** PlanOptions for the engine from validated values (a three-axis machine keeps +Z; the
+ * `gan2014` axis preset sets lead `paperLeadDeg` and tilt 0, as `--axis-preset gan2014`;
+ * options of the space-filling curve go only with that strategy). */
+export function planOptions(values, { fiveAxis, paperLeadDeg = 10 }) {
   const o = {};
   for (const p of PARAMS) {
     if (!p.field) continue;
     const v = values[p.key];
     if (v === null || v === '' || v === undefined) continue;
+    if (p.isfcOnly && values.strategy !== 'isfc') continue;
     o[p.field] = v;
+  }
+  if (fiveAxis && values['axis-preset'] === 'gan2014') {
+    o.lead_deg = paperLeadDeg;
+    o.tilt_deg = 0;
   }
   if (!fiveAxis) {
     o.max_tilt_deg = 0;

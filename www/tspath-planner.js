@@ -5,7 +5,7 @@
 //   <tspath-planner model="keycap-convex" scallop="0.01" plan></tspath-planner>
 //
 // Attributes: `model` (a built-in sample), every parameter of params.js by its key
-// (`tool-radius`, `scallop`, `machine`, `dialect`, ...), `plan` (plan once the model is
+// (`tool-radius`, `scallop`, `strategy`, `machine`, `dialect`, ...), `plan` (plan once the model is
 // loaded) and `sync-url` (read the parameters from the page's URL and keep it up to date, so a
 // link reproduces the plan). The engine runs in a Web Worker (worker.js, through client.js);
 // this thread only draws and answers the user. The host's `data-state` says where it is:
@@ -14,9 +14,11 @@
 // `data-verify` whether the cutting simulation is running, done or failed; `data-stale`
 // that the parameters no longer match the plan shown (its downloads are off).
 import { CancelledError, EngineClient } from './client.js';
-import { KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour } from './colours.js';
+import {
+  ISFC_LAYER, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour,
+} from './colours.js';
 import { area, bytes, deg, int, minutes, mm, mmSig, ms, pct, share } from './format.js';
-import { GROUPS, PARAMS, byKey, planOptions, validate } from './params.js';
+import { GROUPS, PARAMS, byKey, flagOn, planOptions, validate } from './params.js';
 
 /** Plans faster than this (ms, planning and posting) are redone on every change. */
 const AUTO_REPLAN_MS = 1500;
@@ -98,6 +100,7 @@ const TEMPLATE = `
       <div id="drop-hint" class="drop-hint" hidden>Drop a .tsm, .obj or .json model to open it</div>
       <div id="heat-legend" class="heat-legend" hidden aria-label="Heat map colours"></div>
       <div id="rest-legend" class="rest-legend" hidden aria-label="Rest area colours"></div>
+      <div id="isfc-legend" class="isfc-legend" hidden aria-label="Cells and tree colours"></div>
     </div>
     <div class="layers" role="group" aria-label="What the view shows">
       <span class="radio" role="radiogroup" aria-label="Surface colours">
@@ -105,6 +108,7 @@ const TEMPLATE = `
         <label class="inline"><input type="radio" name="colour" id="colour-heat" value="heat" disabled> Scallop heat map</label>
       </span>
       <label class="inline" title="What the plan leaves unmachined, coloured by why"><input type="checkbox" id="layer-rest" checked disabled> Rest area</label>
+      <label class="inline" id="layer-isfc-label" title="Space-filling-curve plans: the 2 × 2 cells of grid points and the tree that joins them into one pass"><input type="checkbox" id="layer-isfc" disabled> Cells and tree</label>
       <label class="inline"><input type="checkbox" id="layer-path" checked> Path</label>
       <label class="inline"><input type="checkbox" id="layer-tool" checked> Tool</label>
       <label class="inline"><input type="checkbox" id="layer-cage"> Control mesh</label>
@@ -143,9 +147,16 @@ const TEMPLATE = `
   </aside>
 </div>`;
 
+/** The strategies as the statistics name them. */
+const STRATEGY_NAMES = {
+  isoparametric: 'patch by patch (isoparametric)',
+  isfc: 'one continuous pass (space-filling curve)',
+};
+
 /** Statistics rows: id, label, value from (report, verification summary, context); the
  * context has `verify_ms`, `area_mm2` (the model's) and `samples` (the simulation's start). */
 const STATS = [
+  ['strategy', 'Strategy', (r, v, x) => `${STRATEGY_NAMES[r.strategy] ?? r.strategy}${x.plain ? ', plain curve (no repairs)' : ''}`],
   ['length_mm', 'Path length', (r) => mm(r.length_mm, 1)],
   ['cutting_length_mm', 'Cutting length', (r) => mm(r.cutting_length_mm, 1)],
   ['link_length_mm', 'Links on the surface', (r) => mm(r.link_length_mm, 1)],
@@ -183,6 +194,20 @@ const STATS = [
   ['plan_ms', 'Planning time', (r) => ms(r.plan_ms)],
   ['verify_ms', 'Simulation time', (r, v, x) => (v ? ms(x.verify_ms) : '…')],
 ];
+/** Rows of a space-filling-curve plan (`isfc`): what its curve is made of. Id, label, text
+ * and raw value (data-value) from (report, context); the context has `start` (the curve's
+ * first point, mm). */
+const ISFC_STATS = [
+  ['grid', 'Grid lines, s × t (all patches)', (r) => `${int(r.grid.s_lines)} × ${int(r.grid.t_lines)} lines`, (r) => `${r.grid.s_lines}x${r.grid.t_lines}`],
+  ['vertices', 'Grid points (cutter contacts)', (r) => int(r.grid.vertices), (r) => r.grid.vertices],
+  ['cells', 'Cells (2 × 2 grid points each)', (r) => int(r.cells), (r) => r.cells],
+  ['tree_links', 'Tree links joining the cells', (r) => `${int(r.tree_links)}${r.tree_links === r.cells - 1 ? ' (one pass)' : ''}`, (r) => r.tree_links],
+  ['repaired_cells', 'Cells repaired for parity', (r) => int(r.repaired_cells), (r) => r.repaired_cells],
+  ['compensated_corners', 'Corners with a scallop detour', (r) => int(r.compensated_corners), (r) => r.compensated_corners],
+  ['start_mm', 'Curve starts at', (r, x) => (x.start && x.start.length === 3 ? `${[...x.start].map((c) => c.toFixed(3)).join(', ')} mm` : '—'),
+    (r, x) => (x.start ? [...x.start].join(',') : '')],
+];
+
 /** Raw value of a statistic (for data-value), where it has one. */
 function rawStat(id, r, v) {
   if (id in r) return r[id];
@@ -234,9 +259,8 @@ export class TspathPlanner extends HTMLElement {
       if (value && value !== this.$('sample').value) this.#loadNamed(value);
       return;
     }
-    const el = this.$(`p-${name}`);
-    if (!el) return;
-    el.value = value ?? '';
+    if (!this.$(`p-${name}`)) return;
+    this.#setControl(byKey[name], value ?? '');
     this.#onParamChange(name);
   }
 
@@ -314,11 +338,11 @@ export class TspathPlanner extends HTMLElement {
       for (const [k, v] of new URLSearchParams(location.search)) initial[k] = v;
     }
     for (const p of PARAMS) {
-      if (initial[p.key] !== undefined && initial[p.key] !== null) this.$(`p-${p.key}`).value = initial[p.key];
+      if (initial[p.key] !== undefined && initial[p.key] !== null) this.#setControl(p, initial[p.key]);
     }
     // Patch choices exist once the model is loaded.
     this.pendingPatches = { 'start-patch': initial['start-patch'], 'finish-patch': initial['finish-patch'] };
-    this.#updateMachineControls();
+    this.#updateDependentControls();
     this.ready = true;
     this.#validateAll();
     const model = initial.model || info.samples[0];
@@ -359,7 +383,7 @@ export class TspathPlanner extends HTMLElement {
     for (const [group, title] of GROUPS) {
       const details = document.createElement('details');
       details.id = `group-${group}`;
-      if (group === 'accuracy' || group === 'tool' || group === 'output') details.open = true;
+      if (group === 'accuracy' || group === 'strategy' || group === 'tool' || group === 'output') details.open = true;
       const summary = document.createElement('summary');
       summary.textContent = title;
       details.append(summary);
@@ -371,7 +395,16 @@ export class TspathPlanner extends HTMLElement {
         label.htmlFor = id;
         label.textContent = p.unit ? `${p.label} (${p.unit})` : p.label;
         let control;
-        if (p.kind === 'number') {
+        if (p.kind === 'flag') {
+          // A checkbox with its label beside it.
+          control = document.createElement('input');
+          control.type = 'checkbox';
+          control.checked = !!p.default;
+          control.value = '1';
+          label.className = 'inline check';
+          label.textContent = ` ${p.label}`;
+          label.prepend(control);
+        } else if (p.kind === 'number') {
           control = document.createElement('input');
           control.type = 'number';
           control.min = p.min;
@@ -396,7 +429,9 @@ export class TspathPlanner extends HTMLElement {
         err.id = `${id}-error`;
         err.setAttribute('aria-live', 'polite');
         control.setAttribute('aria-describedby', err.id);
-        row.append(label, control, err);
+        row.append(label);
+        if (control.parentNode !== label) row.append(control);
+        row.append(err);
         details.append(row);
       }
       form.append(details);
@@ -429,6 +464,11 @@ export class TspathPlanner extends HTMLElement {
     $('layer-rest').addEventListener('change', () => {
       this.restHidden = !$('layer-rest').checked; // kept for the next plans
       this.#showRestLayer();
+    });
+    // Drawn from what the plan brought along: showing it does not plan again.
+    $('layer-isfc').addEventListener('change', () => {
+      this.isfcShown = $('layer-isfc').checked; // kept for the next plans
+      this.#showIsfcLayer();
     });
     $('problems').addEventListener('click', (e) => {
       const b = e.target.closest('button[data-move]');
@@ -546,8 +586,10 @@ export class TspathPlanner extends HTMLElement {
     this.state = 'model-loaded';
     this.dataset.model = m.summary.name;
     this.dataset.meshChordalMm = String(m.chordal_mm);
-    this.#status(`Loaded ${m.summary.name}: ${m.summary.patches} patches. Choose parameters and plan.`);
-    this.#validateAll();
+    const { errors } = this.#validateAll();
+    // A wrong value from the URL or an attribute is said at once, not only at its field.
+    if (errors) this.#status(`Loaded ${m.summary.name}: ${m.summary.patches} patches. Before planning: ${errors[0]}`, true);
+    else this.#status(`Loaded ${m.summary.name}: ${m.summary.patches} patches. Choose parameters and plan.`);
     this.#syncUrl();
     return true;
   }
@@ -658,8 +700,32 @@ export class TspathPlanner extends HTMLElement {
 
   #raw() {
     const raw = {};
-    for (const p of PARAMS) raw[p.key] = this.$(`p-${p.key}`).value;
+    for (const p of PARAMS) {
+      const el = this.$(`p-${p.key}`);
+      raw[p.key] = p.kind === 'flag' ? (el.checked ? '1' : '0') : el.value;
+    }
     return raw;
+  }
+
+  /** Sets a parameter's control from text (URL, attribute): a flag is on unless `0`, `false`,
+   * `no` or `off` (a bare attribute is on); a choice that is not offered is kept as an extra
+   * option, so that validation names it instead of the select dropping it silently. */
+  #setControl(p, value) {
+    const el = this.$(`p-${p.key}`);
+    if (p.kind === 'flag') {
+      el.checked = flagOn(value);
+      return;
+    }
+    const v = String(value);
+    if (el.tagName === 'SELECT' && p.choices?.length) {
+      for (const o of [...el.options]) if (o.dataset.unknown) o.remove();
+      if (v !== '' && ![...el.options].some((o) => o.value === v)) {
+        const o = new Option(`${v} (not a choice)`, v);
+        o.dataset.unknown = '1';
+        el.append(o);
+      }
+    }
+    el.value = v;
   }
 
   get #fiveAxis() {
@@ -667,12 +733,25 @@ export class TspathPlanner extends HTMLElement {
     return !!(this.machineRotaries && this.machineRotaries[m] && this.machineRotaries[m].rotaries);
   }
 
-  #updateMachineControls() {
+  /** Enables the controls that apply: tool-axis settings on five-axis machines only, lead and
+   * tilt unless the axis preset sets them, the plain curve with the space-filling curve only. */
+  #updateDependentControls() {
     const five = this.#fiveAxis;
+    const preset = this.$('p-axis-preset').value;
     for (const p of PARAMS.filter((q) => q.fiveAxis)) {
       const el = this.$(`p-${p.key}`);
-      el.disabled = !five;
-      el.title = five ? '' : 'Needs a five-axis machine: a three-axis machine keeps the tool axis at +Z';
+      const byPreset = five && preset && (p.key === 'lead' || p.key === 'tilt');
+      // A preset left on when the machine became three-axis stays changeable, to be undone.
+      const stuck = !five && p.key === 'axis-preset' && !!preset;
+      el.disabled = (!five && !stuck) || !!byPreset;
+      el.title = !five ? 'Needs a five-axis machine: a three-axis machine keeps the tool axis at +Z'
+        : byPreset ? `Set by the tool axis preset (${this.info?.paperLeadDeg ?? 10}° lead, 0° tilt)` : '';
+    }
+    const isfc = this.$('p-strategy').value === 'isfc';
+    for (const p of PARAMS.filter((q) => q.isfcOnly)) {
+      const el = this.$(`p-${p.key}`);
+      el.disabled = !isfc;
+      el.title = isfc ? '' : 'Only for the space-filling curve (one continuous pass)';
     }
     const m = this.machineRotaries?.[this.$('p-machine').value];
     this.$('p-machine').title = m ? m.description : '';
@@ -697,7 +776,12 @@ export class TspathPlanner extends HTMLElement {
   }
 
   #onParamChange(key) {
-    if (key === 'machine') this.#updateMachineControls();
+    // A choice made in the select replaces a value that was not a choice.
+    const sel = this.$(`p-${key}`);
+    if (sel && sel.tagName === 'SELECT') {
+      for (const o of [...sel.options]) if (o.dataset.unknown && o.value !== sel.value) o.remove();
+    }
+    if (key === 'machine' || key === 'strategy' || key === 'axis-preset') this.#updateDependentControls();
     if (key === 'tool-radius') this.#concaveHint();
     const v = this.#validateAll();
     this.#syncUrl();
@@ -738,7 +822,7 @@ export class TspathPlanner extends HTMLElement {
   }
 
   #planOptions(values) {
-    return planOptions(values, { fiveAxis: this.#fiveAxis });
+    return planOptions(values, { fiveAxis: this.#fiveAxis, paperLeadDeg: this.info?.paperLeadDeg });
   }
 
   /** Whether the plan shown is the plan of the parameters as they are now: every plan
@@ -839,6 +923,7 @@ export class TspathPlanner extends HTMLElement {
     this.plan = { ...result, planReport: result.report, options, values: v.values, workerHasPlan: true };
     this.view.setPath(result);
     this.#showRest();
+    this.#showIsfc();
     this.#showTool(v.values);
     const n = result.kinds.length;
     const scrub = this.$('scrub');
@@ -1016,6 +1101,7 @@ export class TspathPlanner extends HTMLElement {
       this.view.setTool(null);
       this.view.setHeat(null);
       this.view.setRest(null);
+      this.view.setIsfc(null);
     }
     this.$('colour-heat').disabled = true;
     this.$('scrub').disabled = true;
@@ -1031,6 +1117,9 @@ export class TspathPlanner extends HTMLElement {
     this.$('heat-legend').hidden = true;
     this.$('rest-legend').hidden = true;
     this.$('layer-rest').disabled = true;
+    this.$('isfc-legend').hidden = true;
+    this.$('layer-isfc').disabled = true;
+    this.$('layer-isfc').checked = false;
     delete this.dataset.verify;
     delete this.dataset.status;
     this.#markStale(false);
@@ -1041,10 +1130,16 @@ export class TspathPlanner extends HTMLElement {
     if (!p) return;
     const r = p.report;
     const v = p.verification ? p.verification.summary : null;
-    const ctx = { ...(p.verification || {}), area_mm2: this.model.area_mm2 };
+    const ctx = { ...(p.verification || {}), area_mm2: this.model.area_mm2, plain: !!p.options.isfc_plain };
     const rows = STATS.map(([id, label, f]) => [id, label, f(r, v, ctx), rawStat(id, r, v)]);
     const time = rows.find((x) => x[0] === 'machining_time_min');
     time[1] = `Machining time at ${int(p.options.feed_mm_min ?? 1000)} mm/min`;
+    if (r.strategy === 'isfc' && r.grid) {
+      // After the retractions: what the one pass is made of.
+      const at = rows.findIndex((x) => x[0] === 'retractions') + 1;
+      const x = { start: p.isfc?.start };
+      rows.splice(at, 0, ...ISFC_STATS.map(([id, label, f, raw]) => [id, label, f(r, x), raw(r, x)]));
+    }
     this.#facts(this.$('stats'), rows);
     if (v) this.$('stats-error_bound_target_mm').dataset.reached = String(v.error_bound_mm <= v.error_bound_target_mm);
     this.#showProblems();
@@ -1184,6 +1279,49 @@ export class TspathPlanner extends HTMLElement {
     const on = this.$('layer-rest').checked && !this.$('layer-rest').disabled;
     this.view.setLayers({ rest: on });
     this.$('rest-legend').hidden = !on;
+  }
+
+  /** A space-filling-curve plan's cells and tree in the view (a layer, off until asked for),
+   * and its legend. Other plans have none: the box is off and says why. */
+  #showIsfc() {
+    const c = this.plan?.isfc;
+    this.view.setIsfc(c ? { cells: c.cells, tree: c.tree, across: c.across } : null);
+    const box = this.$('layer-isfc');
+    box.disabled = !c;
+    box.checked = !!c && !!this.isfcShown;
+    this.$('layer-isfc-label').title = c
+      ? 'The 2 × 2 cells of grid points and the tree that joins them into one pass'
+      : 'Only a space-filling-curve plan (strategy: one continuous pass) has cells and a tree';
+    const legend = this.$('isfc-legend');
+    legend.replaceChildren();
+    if (c) {
+      const nCells = c.cells.length / 24;
+      const nLinks = c.tree.length / 6;
+      const nAcross = c.across.reduce((a, x) => a + x, 0);
+      const title = document.createElement('div');
+      title.className = 'title';
+      title.textContent = 'Space-filling curve';
+      const line = (colour, text) => {
+        const sw = document.createElement('span');
+        sw.className = 'swatch line';
+        sw.style.setProperty('--c', hexCss(colour));
+        sw.textContent = text;
+        return sw;
+      };
+      legend.append(
+        title,
+        line(ISFC_LAYER.cell, `${int(nCells)} cell outlines (grid lines between contact points)`),
+        line(ISFC_LAYER.tree, `${int(nLinks - nAcross)} tree links between cell centres`),
+        line(ISFC_LAYER.across, `${int(nAcross)} tree links across patch sides`),
+      );
+    }
+    this.#showIsfcLayer();
+  }
+
+  #showIsfcLayer() {
+    const on = this.$('layer-isfc').checked && !this.$('layer-isfc').disabled;
+    this.view.setLayers({ isfc: on });
+    this.$('isfc-legend').hidden = !on;
   }
 
   // ---------------------------------------------------------------- view
@@ -1363,7 +1501,7 @@ export class TspathPlanner extends HTMLElement {
     const raw = this.#raw();
     for (const p of PARAMS) {
       const v = raw[p.key];
-      const d = p.default === null ? '' : String(p.default);
+      const d = p.kind === 'flag' ? (p.default ? '1' : '0') : p.default === null ? '' : String(p.default);
       if (v !== '' && v !== d && !(p.kind === 'number' && Number(v) === Number(d) && d !== '')) q.set(p.key, v);
     }
     if (this.plan) q.set('plan', '1');
@@ -1392,7 +1530,7 @@ export class TspathPlanner extends HTMLElement {
     return n;
   }
 
-  /** Pixels a layer (`path`, `tool`, `cage`, `eps`, `rest`) changes when shown (it is left
+  /** Pixels a layer (`path`, `tool`, `cage`, `eps`, `rest`, `isfc`) changes when shown (it is left
    * as it was). */
   layerPixels(layer) {
     const on = this.view.layers[layer];

@@ -1,9 +1,11 @@
 // Fallback view for browsers without WebGL, on a 2D canvas: shaded surface triangles
 // (painter's algorithm), patch colours or the heat map, the rest area a plan leaves (by
-// reason, sorted with the surface, and a ring at each region), extraordinary points, control
-// mesh, the path by kind and the tool as its outline. Same interface as View3D. Z is up; mm.
+// reason, sorted with the surface, and a ring at each region), a space-filling curve's cells
+// and tree (projected like everything else, drawn over the surface), extraordinary points,
+// control mesh, the path by kind and the tool as its outline. Same interface as View3D. Z is
+// up; mm.
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour,
 } from './colours.js';
 
 const rgb = (c) => [c >> 16 & 255, c >> 8 & 255, c & 255];
@@ -22,9 +24,10 @@ export class View2D {
     this.tool = null;
     this.heat = null;
     this.rest = null;
+    this.isfc = null;
     this.center = [0, 0, 0];
     this.radius = 1;
-    this.layers = { surface: true, rest: true, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, isfc: false, path: true, tool: true, cage: false, eps: true };
     this.#bindInput();
     this.resizer = new ResizeObserver(() => this.resize());
     this.resizer.observe(canvas);
@@ -45,6 +48,7 @@ export class View2D {
     this.path = null;
     this.tool = null;
     this.rest = null;
+    this.isfc = null;
     this.fit();
   }
 
@@ -56,6 +60,12 @@ export class View2D {
   /** The rest area (see View3D.setRest) or null. */
   setRest(rest) {
     this.rest = rest && (rest.positions.length || rest.regions?.length) ? rest : null;
+    this.render();
+  }
+
+  /** A space-filling curve's cells and tree (see View3D.setIsfc) or null. */
+  setIsfc(isfc) {
+    this.isfc = isfc && isfc.cells.length ? isfc : null;
     this.render();
   }
 
@@ -152,6 +162,7 @@ export class View2D {
     const proj = this.#project();
     if (this.layers.surface || (this.layers.rest && this.rest)) this.#drawSurface(proj);
     if (this.layers.rest && this.rest) this.#drawRestRings(proj);
+    if (this.layers.isfc && this.isfc) this.#drawIsfc(proj);
     if (this.layers.cage) this.#drawCage(proj);
     if (this.layers.eps) this.#drawEps(proj);
     if (this.layers.path && this.path) this.#drawPath(proj);
@@ -248,6 +259,30 @@ export class View2D {
       ctx.arc(a[0], a[1], 7, 0, 2 * Math.PI);
       ctx.stroke();
     }
+  }
+
+  /** Cell outlines, then the tree's links (those across a patch side in their own colour). */
+  #drawIsfc(proj) {
+    const ctx = this.ctx;
+    const segments = (a, which, colour, width, alpha) => {
+      ctx.strokeStyle = hexCss(colour);
+      ctx.lineWidth = width;
+      ctx.globalAlpha = alpha;
+      ctx.beginPath();
+      for (let i = 0, s = 0; i < a.length; i += 6, s++) {
+        if (!which(s)) continue;
+        const p = proj(a[i], a[i + 1], a[i + 2]);
+        const q = proj(a[i + 3], a[i + 4], a[i + 5]);
+        ctx.moveTo(p[0], p[1]);
+        ctx.lineTo(q[0], q[1]);
+      }
+      ctx.stroke();
+      ctx.globalAlpha = 1;
+    };
+    const { cells, tree, across } = this.isfc;
+    segments(cells, () => true, ISFC_LAYER.cell, 0.75, 0.7);
+    segments(tree, (s) => !across[s], ISFC_LAYER.tree, 1.25, 1);
+    segments(tree, (s) => across[s], ISFC_LAYER.across, 1.5, 1);
   }
 
   #drawCage(proj) {

@@ -1,12 +1,13 @@
 // The 3D view with three.js (vendored in www/vendor/): shaded surface with patches in
 // colours (or the scallop heat map), extraordinary points, optional control mesh, the rest
-// area a plan leaves (coloured by reason, with a ring at each region), the tool path by
+// area a plan leaves (coloured by reason, with a ring at each region), a space-filling
+// curve's cells and tree (off until shown), the tool path by
 // patch with links and retractions drawn apart, and the tool (ball, shank, holder).
 // Z is up; lengths are millimetres. Renders on demand, not in a loop.
 import * as THREE from './vendor/three.module.js';
 import { OrbitControls } from './vendor/OrbitControls.js';
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, pathColour,
 } from './colours.js';
 
 const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
@@ -29,7 +30,7 @@ export class View3D {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.screenSpacePanning = true;
     this.controls.addEventListener('change', () => this.render());
-    this.layers = { surface: true, rest: true, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, isfc: false, path: true, tool: true, cage: false, eps: true };
     this.groups = {};
     for (const k of Object.keys(this.layers)) {
       this.groups[k] = new THREE.Group();
@@ -203,6 +204,40 @@ export class View3D {
     this.render();
   }
 
+  /** A space-filling curve's cells and tree: `cells` and `tree` (Float32Array, `x y z x y z`
+   * per segment, on the surface, mm) and `across` (Uint8Array, per tree segment, 1 where it
+   * crosses a patch side); null for none. Drawn over the surface, the tree over the cells. */
+  setIsfc(isfc) {
+    this.#clear(this.groups.isfc);
+    if (isfc && isfc.cells.length) {
+      const lines = (positions, colours, opacity) => {
+        const g = new THREE.BufferGeometry();
+        g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(positions), 3));
+        g.setAttribute('color', new THREE.BufferAttribute(colours, 3));
+        const mat = new THREE.LineBasicMaterial({ vertexColors: true, transparent: opacity < 1, opacity });
+        return new THREE.LineSegments(g, mat);
+      };
+      const c = new THREE.Color();
+      const fill = (n, colourOf) => {
+        const col = new Float32Array(6 * n);
+        for (let s = 0; s < n; s++) {
+          c.setHex(colourOf(s));
+          col.set([c.r, c.g, c.b, c.r, c.g, c.b], 6 * s);
+        }
+        return col;
+      };
+      const cells = lines(isfc.cells, fill(isfc.cells.length / 6, () => ISFC_LAYER.cell), 0.7);
+      cells.renderOrder = 3;
+      this.groups.isfc.add(cells);
+      if (isfc.tree.length) {
+        const tree = lines(isfc.tree, fill(isfc.tree.length / 6, (s) => (isfc.across[s] ? ISFC_LAYER.across : ISFC_LAYER.tree)), 1);
+        tree.renderOrder = 4;
+        this.groups.isfc.add(tree);
+      }
+    }
+    this.render();
+  }
+
   /** The path: `cl` (Float64Array, ball centres), `kinds` (Uint8Array), `patchIds`. */
   setPath(path) {
     this.#clear(this.groups.path);
@@ -290,7 +325,7 @@ export class View3D {
     this.render();
   }
 
-  /** Shows or hides layers: `{surface, rest, path, tool, cage, eps}`. */
+  /** Shows or hides layers: `{surface, rest, isfc, path, tool, cage, eps}`. */
   setLayers(layers) {
     Object.assign(this.layers, layers);
     this.render();

@@ -92,8 +92,9 @@ const ops = {
       return true;
     };
     plan = model.plan(options, progress);
+    const report = plan.report();
     const result = {
-      report: plan.report(),
+      report,
       cl: plan.clPoints(),
       cc: plan.ccPoints(),
       axes: plan.axes(),
@@ -101,8 +102,13 @@ const ops = {
       patchIds: plan.patchIds(),
       rest: plan.restPositions(),
       restReasons: plan.restReasons(),
+      // A space-filling curve's cells and tree, for the layer (drawn without planning again).
+      isfc: report.strategy === 'isfc' ? {
+        cells: plan.isfcCells(), tree: plan.isfcTree(), across: plan.isfcTreeAcross(), start: plan.isfcStart(),
+      } : null,
     };
     const transfer = ['cl', 'cc', 'axes', 'kinds', 'patchIds', 'rest', 'restReasons'].map((k) => result[k].buffer);
+    if (result.isfc) transfer.push(...Object.values(result.isfc).map((a) => a.buffer));
     return { result, transfer };
   },
 

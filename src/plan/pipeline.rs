@@ -55,6 +55,9 @@ pub struct Planned {
     pub rest_fraction: f64,
     /// What the space-filling curve is made of (`isfc` only).
     pub isfc: Option<super::isfc::IsfcStats>,
+    /// The space-filling curve's cells and tree as segments, for drawing (`isfc` only; the
+    /// strategy sets it after the pipeline).
+    pub isfc_layer: Option<super::isfc::layer::Layer>,
 }
 
 /// Runs the pipeline on `draft`. `progress` receives the fraction of this part done and
@@ -162,6 +165,7 @@ pub fn finish(
     progress(1.0);
     Ok(Planned {
         isfc: draft.isfc,
+        isfc_layer: None,
         strategy: draft.strategy,
         toolpath: path,
         forced_retractions: draft.forced_retractions,

@@ -8,6 +8,7 @@
 use crate::error::Error;
 use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
+use crate::plan::isfc::layer::Layer as IsfcLayer;
 use crate::plan::{PlanOptions, PlanReport, Toolpath};
 use crate::surface::tessellate::Tessellation;
 use crate::verify::{self, CutterPath, RestRect, Verification, VerifyOptions};
@@ -78,6 +79,13 @@ pub fn machine_json(name: &str) -> Result<String, JsError> {
 #[wasm_bindgen(js_name = planVerifyMaxSamples)]
 pub fn plan_verify_max_samples() -> f64 {
     verify::PLAN_VERIFY_MAX_SAMPLES as f64
+}
+
+/// Lead of the tool axis from the surface normal in the `gan2014` axis preset (degrees): the
+/// axis of Gan et al. (2014), as `tspath plan --axis-preset gan2014` sets it (tilt 0°).
+#[wasm_bindgen(js_name = paperLeadDeg)]
+pub fn paper_lead_deg() -> f64 {
+    crate::plan::options::PAPER_LEAD_DEG
 }
 
 /// The crate version, for page footers and G-code headers.
@@ -191,10 +199,11 @@ impl WasmModel {
         })
     }
 
-    /// Plans the isoparametric zig-zag. `options` is a plain object with any of the
-    /// [`PlanOptions`] fields (`tool_radius_mm`, `scallop_mm`, `chordal_mm`, ...);
-    /// `progress`, if given, is called with the fraction done and may return `false` to
-    /// cancel.
+    /// Plans with the strategy `options.strategy` names (`isoparametric`, the default, or
+    /// `isfc`, the space-filling curve). `options` is a plain object with any of the
+    /// [`PlanOptions`] fields (`tool_radius_mm`, `scallop_mm`, `chordal_mm`, `strategy`,
+    /// `isfc_plain`, ...); `progress`, if given, is called with the fraction done and may
+    /// return `false` to cancel.
     pub fn plan(
         &self,
         options: JsValue,
@@ -226,6 +235,7 @@ impl WasmModel {
             strategy: planned.strategy.into(),
         };
         Ok(WasmPlan {
+            isfc_layer: planned.isfc_layer,
             path: planned.toolpath,
             report,
             opts,
@@ -281,6 +291,20 @@ pub struct WasmPlan {
     /// The rest area as triangles (`x y z` per vertex, mm) and their reasons.
     rest_positions: Vec<f32>,
     rest_why: Vec<u8>,
+    /// The space-filling curve's cells and tree (`isfc` plans only), kept from planning.
+    isfc_layer: Option<IsfcLayer>,
+}
+
+impl WasmPlan {
+    /// The cells-and-tree layer, or an error saying that only `isfc` plans have one.
+    fn layer(&self) -> Result<&IsfcLayer, JsError> {
+        self.isfc_layer.as_ref().ok_or_else(|| {
+            JsError::new(&format!(
+                "this plan's strategy is {}: only a space-filling-curve plan (strategy isfc) has cells and a tree to draw",
+                self.report.strategy
+            ))
+        })
+    }
 }
 
 #[wasm_bindgen(js_class = Plan)]
@@ -359,6 +383,37 @@ impl WasmPlan {
     pub fn rest_reasons(&self) -> js_sys::Uint8Array {
         js_sys::Uint8Array::from(&self.rest_why[..])
     }
+    /// `isfc` plans: the outline of every 2 × 2 cell of grid vertices, four segments per
+    /// cell between the vertices' contact points, `x y z x y z` per segment (mm). Throws
+    /// for other strategies.
+    #[wasm_bindgen(js_name = isfcCells)]
+    pub fn isfc_cells(&self) -> Result<js_sys::Float32Array, JsError> {
+        Ok(js_sys::Float32Array::from(&self.layer()?.cells[..]))
+    }
+
+    /// `isfc` plans: the links of the spanning tree, one segment per link from the centre of
+    /// one cell to the centre of the other (the mean of its corners' contact points),
+    /// `x y z x y z` (mm). Throws for other strategies.
+    #[wasm_bindgen(js_name = isfcTree)]
+    pub fn isfc_tree(&self) -> Result<js_sys::Float32Array, JsError> {
+        Ok(js_sys::Float32Array::from(&self.layer()?.tree[..]))
+    }
+
+    /// `isfc` plans: per tree link of `isfcTree`, 1 if it joins two patches across the side
+    /// they share, else 0. Throws for other strategies.
+    #[wasm_bindgen(js_name = isfcTreeAcross)]
+    pub fn isfc_tree_across(&self) -> Result<js_sys::Uint8Array, JsError> {
+        Ok(js_sys::Uint8Array::from(&self.layer()?.across[..]))
+    }
+
+    /// `isfc` plans: where the curve starts, `x y z` (mm; empty if it has no loop). Throws
+    /// for other strategies.
+    #[wasm_bindgen(js_name = isfcStart)]
+    pub fn isfc_start(&self) -> Result<js_sys::Float64Array, JsError> {
+        let s = self.layer()?.start_mm.map_or(Vec::new(), |p| p.to_vec());
+        Ok(js_sys::Float64Array::from(&s[..]))
+    }
+
     /// The default G-code program, in mm: three-axis (plain dialect) while the tool axis
     /// stays at +Z, else LinuxCNC joint values for the `table-table-ac` machine. Written when
     /// asked for, so a plan whose default program cannot be written is still a plan; throws

@@ -10,7 +10,7 @@
 // Prints, without asserting: the gzipped size of the wasm and the time to the first model
 // drawn.
 import { chromium } from 'playwright-core';
-import { execFileSync, spawnSync } from 'node:child_process';
+import { execFile, execFileSync, spawnSync } from 'node:child_process';
 import { mkdir, mkdtemp, readFile, rm, writeFile } from 'node:fs/promises';
 import { readFileSync, readdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -64,6 +64,26 @@ function cliPlan(model, { toolRadius, scallop, machine = '3-axis', dialect = 'li
   check((status === EXIT_PROBLEMS) === (report.status === 'planned_with_problems'),
     `the CLI exits ${status} for a plan whose status is ${report.status}`);
   return { report, status, gcode: readFileSync(join(work, `${stem}.nc`), 'utf8') };
+}
+
+/** As `cliPlan`, without waiting: the CLI runs beside the browser (a promise of the same). */
+function cliPlanAsync(model, { toolRadius, scallop, samples, maxSamples, extra = [] }) {
+  const stem = `${model.replace(/^.*\//, '')}-async-${toolRadius}-${scallop}`;
+  const args = ['plan', model, '--tool-radius', String(toolRadius), '--scallop', String(scallop),
+    ...extra, '-o', `${stem}.nc`, '--report', `${stem}.json`];
+  if (samples) args.push('--verify', '--verify-samples', String(samples));
+  if (samples && maxSamples) args.push('--verify-max-samples', String(maxSamples));
+  return new Promise((resolve, reject) => {
+    execFile(cli, args, { cwd: work, maxBuffer: 1 << 28 }, (err, stdout, stderr) => {
+      const status = err ? err.code : 0;
+      if (status !== 0 && status !== EXIT_PROBLEMS) {
+        reject(new Error(`tspath ${args.join(' ')} exited with ${status}: ${stderr.trim()}`));
+        return;
+      }
+      const report = JSON.parse(readFileSync(join(work, `${stem}.json`), 'utf8'));
+      resolve({ report, status, gcode: readFileSync(join(work, `${stem}.nc`), 'utf8') });
+    });
+  });
 }
 
 // ------------------------------------------------------------------ helpers
@@ -898,6 +918,226 @@ test('without WebGL the 2D view draws the model, the path and the rest area', as
   check(rest > 500, `the rest area is drawn in 2D (${rest} px)`);
   await page.screenshot({ path: join(shots, 'fallback-2d-rest.png') });
   return `2D view: ${drawn} px drawn, path ${pathPixels} px; rest area ${rest} px`;
+}, { noWebGL: true });
+
+/** Compares a report the page got from wasm with the CLI's (native) key by key: the same
+ * keys, every string, count and boolean equal, every number equal or within `rel` of the
+ * CLI's (relative); `plan_ms` (wall time) and the keys in `skip` are left out. Returns how
+ * many numbers were compared, how many were bit-equal, and the largest relative
+ * difference. */
+function compareReports(page, cli, what, { rel = 1e-9, skip = [] } = {}) {
+  const out = { numbers: 0, exact: 0, worst: 0, keys: 0 };
+  const walk = (a, b, at) => {
+    if (typeof b === 'number' && typeof a === 'number') {
+      out.numbers++;
+      if (a === b) {
+        out.exact++;
+        return;
+      }
+      const d = Math.abs(a - b) / Math.max(Math.abs(a), Math.abs(b));
+      out.worst = Math.max(out.worst, d);
+      check(d <= rel, `${what}: ${at} is ${a} in wasm, ${b} natively (relative difference ${d.toExponential(2)})`);
+      return;
+    }
+    if (Array.isArray(b)) {
+      check(Array.isArray(a) && a.length === b.length, `${what}: ${at} has ${a?.length} items in wasm, ${b.length} natively`);
+      b.forEach((x, k) => walk(a[k], x, `${at}[${k}]`));
+      return;
+    }
+    if (b && typeof b === 'object') {
+      check(a && typeof a === 'object', `${what}: ${at} is ${JSON.stringify(a)} in wasm, an object natively`);
+      const ka = Object.keys(a).filter((k) => !(at === 'report' && (k === 'plan_ms' || skip.includes(k)))).sort();
+      const kb = Object.keys(b).filter((k) => !(at === 'report' && (k === 'plan_ms' || skip.includes(k)))).sort();
+      check(JSON.stringify(ka) === JSON.stringify(kb), `${what}: ${at} has keys ${ka} in wasm, ${kb} natively`);
+      if (at === 'report') out.keys = kb.length;
+      for (const k of kb) walk(a[k], b[k], `${at}.${k}`);
+      return;
+    }
+    check(a === b, `${what}: ${at} is ${JSON.stringify(a)} in wasm, ${JSON.stringify(b)} natively`);
+  };
+  walk(page, cli, 'report');
+  return out;
+}
+
+/** The start of the space-filling curve as the report's note says it (mm, three decimals). */
+const noteStart = (r) => (r.notes.map((n) => n.match(/starting at \(([^)]*)\) mm/)).find(Boolean) || [])[1];
+
+/** Checks the rows the page shows for a space-filling-curve plan against the CLI's report. */
+async function checkIsfcStats(page, r, what, { plain = false } = {}) {
+  const text = async (id) => (await page.textContent(`#stats-${id}`)).trim();
+  const n = (x) => x.toLocaleString('en-US');
+  check(await text('strategy') === `one continuous pass (space-filling curve)${plain ? ', plain curve (no repairs)' : ''}`,
+    `${what}: strategy shown as “${await text('strategy')}”`);
+  check(await text('grid') === `${n(r.grid.s_lines)} × ${n(r.grid.t_lines)} lines`, `${what}: grid shown as “${await text('grid')}”, CLI ${JSON.stringify(r.grid)}`);
+  for (const id of ['cells', 'repaired_cells', 'compensated_corners']) {
+    check((await stat(page, id)).value === r[id] && (await text(id)) === n(r[id]), `${what}: ${id} shown as “${await text(id)}”, CLI ${r[id]}`);
+  }
+  check((await stat(page, 'vertices')).value === r.grid.vertices, `${what}: grid points`);
+  const links = await text('tree_links');
+  check(links.startsWith(n(r.tree_links)) && (r.tree_links !== r.cells - 1 || /one pass/.test(links)), `${what}: tree links shown as “${links}”, CLI ${r.tree_links}`);
+  const start = await text('start_mm');
+  check(start === `${noteStart(r)} mm`, `${what}: start shown as “${start}”, the CLI's note says (${noteStart(r)}) mm`);
+  return { start };
+}
+
+test('isfc: plate-hole in one pass; the report from wasm is the CLI\'s key by key; cells and tree layer; a strategy change makes the plan stale', async (page, url) => {
+  const what = 'plate-hole isfc';
+  await page.goto(`${url}?model=plate-hole&strategy=isfc&tool-radius=1&scallop=0.05&${SIM}`);
+  await page.waitForSelector(`${HOST}[data-model="plate-hole"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
+  const chosen = await page.$eval(HOST, (el) => el.shadowRoot.getElementById('p-strategy').selectedOptions[0].textContent);
+  check(chosen === 'One continuous pass (space-filling curve)', `?strategy=isfc chooses the curve: “${chosen}”`);
+  check(!(await page.isDisabled('#p-isfc-plain')) && !(await page.isChecked('#p-isfc-plain')), 'the plain curve can be chosen, off by default');
+  check(await page.isDisabled('#p-axis-preset'), 'the axis preset waits for a five-axis machine');
+  check(await page.isDisabled('#layer-isfc'), 'no cells to show before a plan');
+  await page.uncheck('#auto'); // no re-plan behind the test's back
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  await waitVerified(page);
+
+  // The page's report (wasm) against the CLI's (native), key by key.
+  const cli = cliPlan('plate-hole', { toolRadius: 1, scallop: 0.05, extra: ['--strategy', 'isfc'] });
+  const r = cli.report;
+  check(r.strategy === 'isfc' && r.retractions === 0 && r.tree_links === r.cells - 1, `one pass: ${r.retractions} retractions, ${r.cells} cells, ${r.tree_links} links`);
+  const mine = await host(page, (el) => el.plan.planReport);
+  const cmp = compareReports(mine, r, what);
+  const { start } = await checkIsfcStats(page, r, what);
+  check((await stat(page, 'retractions')).value === 0, 'no retraction shown');
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  check(g === cli.gcode, `the program is the CLI's --strategy isfc program (${g.length} vs ${cli.gcode.length} bytes)`);
+
+  // The layer: offered for this plan, off until asked for, drawn from what the plan brought.
+  check(!(await page.isDisabled('#layer-isfc')) && !(await page.isChecked('#layer-isfc')), 'the cells and tree are offered, off until shown');
+  const before = await plans(page);
+  const px = await host(page, (el) => el.layerPixels('isfc'));
+  check(px > 2000, `the cells and tree change ${px} px when shown`);
+  await page.check('#layer-isfc');
+  const legend = await page.textContent('#isfc-legend');
+  check(await page.isVisible('#isfc-legend') && legend.includes(`${r.cells.toLocaleString('en-US')} cell outlines`) && /across patch sides/.test(legend), `legend: ${legend}`);
+  await page.uncheck('#layer-path');
+  await page.screenshot({ path: join(shots, 'isfc-cells-tree.png') });
+  await page.check('#layer-path');
+  await page.uncheck('#layer-isfc');
+  check(await page.isHidden('#isfc-legend'), 'the legend goes with the layer');
+  check(await plans(page) === before && await attr(page, 'data-state') === 'planned', 'showing the layer does not plan again');
+
+  // Another strategy or the plain curve makes the plan stale; back to the plan's, it is not.
+  const stale = async () => page.$eval(HOST, (el) => el.hasAttribute('data-stale'));
+  await setParam(page, 'strategy', 'isoparametric');
+  check(await stale() && await page.isDisabled('#download-gcode'), 'another strategy: the plan is stale, its downloads off');
+  check(await page.isDisabled('#p-isfc-plain'), 'the plain curve is only for the space-filling curve');
+  await setParam(page, 'strategy', 'isfc');
+  check(!(await stale()), 'back to the strategy planned');
+  await page.check('#p-isfc-plain');
+  check(await stale(), 'the plain curve: stale');
+  const q = new URL(page.url()).searchParams;
+  check(q.get('strategy') === 'isfc' && q.get('isfc-plain') === '1', `the URL holds the choices: ${page.url()}`);
+  await page.click('#plan');
+  await waitPlans(page, before + 1);
+  const plain = cliPlan('plate-hole', { toolRadius: 1, scallop: 0.05, extra: ['--strategy', 'isfc', '--isfc-plain'] });
+  const cmpPlain = compareReports(await host(page, (el) => el.plan.planReport), plain.report, `${what} plain`);
+  await checkIsfcStats(page, plain.report, `${what} plain`, { plain: true });
+  check(plain.report.repaired_cells === 0 && plain.report.compensated_corners === 0, 'the plain curve repairs nothing');
+  return `${r.cells} cells, ${r.tree_links} tree links, grid ${r.grid.s_lines} × ${r.grid.t_lines}, start ${start}, 0 retractions; `
+    + `wasm = native on ${cmp.keys} report keys: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); plain curve: ${cmpPlain.exact} of ${cmpPlain.numbers} bit-equal; G-code = CLI; layer ${px} px`;
+});
+
+test('isfc with the gan2014 axis preset on a five-axis machine: the CLI\'s --axis-preset gan2014 plan', async (page, url) => {
+  await page.goto(`${url}?model=dome&strategy=isfc&tool-radius=1&scallop=0.05&machine=table-table-ac&axis-preset=gan2014&${SIM}`);
+  await page.waitForSelector(`${HOST}[data-model="dome"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
+  check(!(await page.isDisabled('#p-axis-preset')), 'the preset is offered on a five-axis machine');
+  for (const k of ['lead', 'tilt']) {
+    check(await page.isDisabled(`#p-${k}`) && /preset/.test(await page.getAttribute(`#p-${k}`, 'title')), `${k} is set by the preset, and says so`);
+  }
+  await page.uncheck('#auto');
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  const cli = cliPlan('dome', { toolRadius: 1, scallop: 0.05, machine: 'table-table-ac', extra: ['--strategy', 'isfc', '--axis-preset', 'gan2014'] });
+  const r = cli.report;
+  const cmp = compareReports(await host(page, (el) => el.plan.planReport), r, 'dome isfc gan2014');
+  check(r.max_axis_step_deg > 15, `the 10° lead turns with the feed (${r.max_axis_step_deg}°)`);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  check(g === cli.gcode, `the five-axis program is the CLI's (${g.length} vs ${cli.gcode.length} bytes)`);
+  // Without the preset the plan is another: stale; on a three-axis machine it is refused.
+  await setParam(page, 'axis-preset', '');
+  check(await page.$eval(HOST, (el) => el.hasAttribute('data-stale')) && !(await page.isDisabled('#p-lead')), 'no preset: stale, lead editable');
+  await setParam(page, 'axis-preset', 'gan2014');
+  check(!(await page.$eval(HOST, (el) => el.hasAttribute('data-stale'))), 'the preset again: the plan shown');
+  await setParam(page, 'machine', '3-axis');
+  check(/needs a five-axis machine/.test(await page.textContent('#p-axis-preset-error')) && await page.isDisabled('#plan'), 'three-axis: the preset is refused, with the reason');
+  await setParam(page, 'axis-preset', '');
+  check(await page.isDisabled('#p-axis-preset') && !(await page.isDisabled('#plan')), 'undone: three-axis plans again, the preset waits for five axes');
+  return `${r.cl_points} CL points, largest axis step ${r.max_axis_step_deg.toFixed(2)}°; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
+});
+
+test('a strategy that is not one is named, planning waits, and the page stays usable', async (page, url) => {
+  await page.goto(`${url}?model=plate-hole&strategy=zigzag&tool-radius=1&scallop=0.05&${SIM}`);
+  await waitState(page, 'model-loaded');
+  const field = (await page.textContent('#p-strategy-error')).trim();
+  check(/zigzag/.test(field) && /isoparametric/.test(field) && /isfc/.test(field), `the field names the value and the choices: ${field}`);
+  check(await page.getAttribute('#p-strategy', 'aria-invalid') === 'true' && await page.isDisabled('#plan'), 'marked, and planning waits');
+  const status = (await page.textContent('#status')).trim();
+  check(await page.$eval('#status', (e) => e.classList.contains('error')) && /zigzag/.test(status), `the status says so: ${status}`);
+  await page.screenshot({ path: join(shots, 'isfc-bad-strategy.png') });
+  // The user picks one: the error goes, and it plans.
+  await setParam(page, 'strategy', 'isfc');
+  check(await page.getAttribute('#p-strategy', 'aria-invalid') === 'false' && !(await page.isDisabled('#plan')), 'fixed by choosing');
+  const offered = await page.$$eval('#p-strategy option', (o) => o.map((x) => x.value));
+  check(JSON.stringify(offered) === '["isoparametric","isfc"]', `the wrong value leaves the list: ${offered}`);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  check(await attr(page, 'data-state') === 'planned' && (await stat(page, 'retractions')).value === 0, 'planned in one pass');
+  // The attribute too: a wrong value makes the plan stale and is named; the right one is not.
+  await host(page, (el) => el.setAttribute('strategy', 'spiral'));
+  check(/spiral/.test(await page.textContent('#status')) && await page.$eval(HOST, (el) => el.hasAttribute('data-stale')), 'the attribute is checked as the URL is');
+  await host(page, (el) => el.setAttribute('strategy', 'isfc'));
+  check(!(await page.$eval(HOST, (el) => el.hasAttribute('data-stale'))), 'back to the plan shown');
+  return `“${field}”`;
+});
+
+test('mouse.tsm with the space-filling curve from the URL: one pass, no gouge, the CLI\'s report', async (page, url) => {
+  const file = join(GRAPETEC, 'mouse.tsm');
+  // 288 128 CL points at the page's defaults: the simulation stays at its first 100 000
+  // samples (no growth), which finds gouges but does not prove the scallop (`unproven`).
+  const n = VERIFY_SAMPLES;
+  // The CLI plans and simulates beside the browser.
+  const t0 = Date.now();
+  const running = cliPlanAsync(file, { toolRadius: 0.5, scallop: 0.01, extra: ['--strategy', 'isfc'], samples: n, maxSamples: n })
+    .then((c) => ({ ...c, ms: Date.now() - t0 }));
+  running.catch(() => {});
+  await page.goto(`${url}?model=grapetec/mouse.tsm&strategy=isfc&samples=${n}&max-samples=${n}&plan=1`);
+  await waitPlans(page, 1, 180000);
+  await waitVerified(page, 180000);
+  const status = (await page.textContent('#status')).trim();
+  const cli = await running;
+  check((cli.status === EXIT_PROBLEMS) === (cli.report.status === 'planned_with_problems'), `the CLI exits ${cli.status} for a plan whose status is ${cli.report.status}`);
+  const cliMs = cli.ms;
+  const r = cli.report;
+  check(r.retractions === 0 && r.tree_links === r.cells - 1, `one pass: ${r.retractions} retractions, ${r.tree_links} links for ${r.cells} cells`);
+  const kinds = (await pageProblems(page)).map((p) => p.kind);
+  check(!kinds.includes('gouge') && (await stat(page, 'gouge_count')).value === 0, `no gouge: ${kinds}`);
+  // The report with the simulation's findings, and the simulation, as the CLI's --verify.
+  const cmp = compareReports(await host(page, (el) => el.plan.report), r, 'mouse.tsm isfc', { skip: ['verify'] });
+  await checkVerification(page, r.verify, 'mouse.tsm isfc');
+  await checkReport(page, r, 'mouse.tsm isfc');
+  await checkIsfcStats(page, r, 'mouse.tsm isfc');
+  const px = await host(page, (el) => el.layerPixels('isfc'));
+  check(px > 2000, `cells and tree drawn (${px} px)`);
+  await page.screenshot({ path: join(shots, 'isfc-mouse.png') });
+  const simMs = (await stat(page, 'verify_ms')).text;
+  return `status “${status}” (simulation ${simMs}; the CLI's plan and simulation ${cliMs} ms); ${r.cl_points} CL points, ${r.cells} cells, problems ${kinds.join(', ') || 'none'}; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal`;
+});
+
+test('without WebGL the 2D view draws the cells and tree', async (page, url) => {
+  await page.goto(`${url}?model=plate-hole&strategy=isfc&tool-radius=1&scallop=0.05&${SIM}&plan=1`);
+  await waitPlans(page, 1);
+  check(await attr(page, 'data-renderer') === '2d', 'the fallback view is used');
+  const px = await host(page, (el) => el.layerPixels('isfc'));
+  check(px > 1000, `cells and tree drawn in 2D (${px} px)`);
+  await page.check('#layer-isfc');
+  await page.screenshot({ path: join(shots, 'isfc-fallback-2d.png') });
+  return `${px} px`;
 }, { noWebGL: true });
 
 // ------------------------------------------------------------------ run

@@ -23,6 +23,7 @@
 pub mod cells;
 pub mod corner;
 pub mod grid;
+pub mod layer;
 pub mod tour;
 pub mod tree;
 
@@ -106,10 +107,12 @@ pub fn plan(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Planned> {
-    let d = draft(model, opts, &mut |f| progress(DRAFT_SHARE * f))?;
-    super::pipeline::finish(model, d, opts, &mut |f| {
+    let (d, layer) = draft_and_layer(model, opts, &mut |f| progress(DRAFT_SHARE * f))?;
+    let mut planned = super::pipeline::finish(model, d, opts, &mut |f| {
         progress(DRAFT_SHARE + (1.0 - DRAFT_SHARE) * f)
-    })
+    })?;
+    planned.isfc_layer = Some(layer);
+    Ok(planned)
 }
 
 /// The curve before it becomes moves: grids, vertices, cells, the candidate links, the tree
@@ -260,6 +263,18 @@ pub fn draft(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Draft> {
+    draft_and_layer(model, opts, progress).map(|(d, _)| d)
+}
+
+/// The curve as a draft for the pipeline, and its cells and tree as drawn.
+fn draft_and_layer(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<(Draft, layer::Layer)> {
+    let kept = curve(model, opts, &mut |f| progress(0.5 * f))?;
+    // The cells and tree as drawn, kept with the plan (the page shows them as a layer).
+    let layer = layer::Layer::of(&kept);
     let Curve {
         grids,
         vertices,
@@ -269,7 +284,7 @@ pub fn draft(
         loops,
         predicted_mm,
         ..
-    } = curve(model, opts, &mut |f| progress(0.5 * f))?;
+    } = kept;
     let r = opts.tool_radius_mm;
     let plain = opts.isfc_plain;
     let h_target = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
@@ -338,7 +353,7 @@ pub fn draft(
     let forced = loops.len().saturating_sub(1);
     let mut d = out.finish("isfc", Vec::new(), worst, forced);
     d.isfc = Some(stats);
-    Ok(d)
+    Ok((d, layer))
 }
 
 /// Samples along a patch side, and golden-section steps after them, finding the point of
