@@ -21,9 +21,9 @@ const USAGE: &str = "usage:
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [-o OUT.nc] [--report REPORT.json]
               [--verify [--verify-samples N] [--verify-max-samples N]]
-              --verify simulates the cut, from N samples (default 1 000 000) up to at most
-              --verify-max-samples (default 8 000 000) until its error bound is a quarter of
-              the scallop
+              --verify simulates the cut, from N samples (default 1 000 000; at least a
+              spacing of a quarter of sqrt(8 r h)) up to at most --verify-max-samples
+              (default 8 000 000) until its error bound is a quarter of the scallop
               exits with 3 after writing its outputs when the plan has problems (rest area,
               gouges, scallop over the request, an unproven simulation), listed on stderr
   tspath compare MODEL [plan's options] [--verify [--verify-max-samples N]] [--markdown]

@@ -59,9 +59,17 @@ fn gcode_from_plan_verifies_like_the_planned_path() {
     assert_eq!(direct["error_bound_target_mm"], 0.005);
     assert!(direct["error_bound_mm"].as_f64().unwrap() <= 0.005);
     assert_eq!(rep["status"], "planned", "{}", rep["problems"]);
-    // Reached with the samples asked for (the grid rounds them a little).
-    assert!((direct["samples"].as_f64().unwrap() - 200000.0).abs() < 1000.0);
-    let samples = "200000".to_string();
+    // Reached at the first round, which starts from the samples asked for or, if more,
+    // from a spacing of a quarter of the flat-surface stepover sqrt(8 r h) = 0.4 mm over
+    // the area (the grid rounds them a little).
+    let area = direct["area_mm2"].as_f64().unwrap();
+    let first = (area / (0.25f64 * 0.4).powi(2)).max(200000.0);
+    let samples = direct["samples"].as_f64().unwrap();
+    assert!(
+        (samples - first).abs() < 0.005 * first,
+        "{samples} vs {first}"
+    );
+    // The program read back, simulated the same way (same start, same bound).
     let verify_args = args(&[
         "verify",
         "dome",
@@ -69,7 +77,9 @@ fn gcode_from_plan_verifies_like_the_planned_path() {
         "--tool-radius",
         "1",
         "--samples",
-        &samples,
+        "200000",
+        "--bound",
+        "0.005",
     ]);
     let out = run(&verify_args).unwrap();
     let again = run(&verify_args).unwrap();

@@ -182,6 +182,11 @@ fn face_size(face: &FaceSurface) -> (f64, f64, f64) {
     (area, lu / n as f64, lv / n as f64)
 }
 
+/// The surface's area (mm²), as the sample grids estimate it.
+pub fn area_mm2(surface: &Surface) -> f64 {
+    surface.faces().iter().map(|f| face_size(f).0).sum()
+}
+
 fn grids(surface: &Surface, samples: usize) -> Vec<FaceGrid> {
     let sizes: Vec<(f64, f64, f64)> = surface.faces().iter().map(face_size).collect();
     let total: f64 = sizes.iter().map(|s| s.0).sum();
