@@ -355,10 +355,8 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
     let planned = plan::plan(&m, &opts, &mut |_| true)?;
     let mut report = planned.report(&opts);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let rest = planned.rest_rects(&m);
-    let path = planned.toolpath;
     let gcode = machine::post(
-        &path,
+        &planned.toolpath,
         &opts,
         &JobInfo {
             model: m.name.clone(),
@@ -369,24 +367,10 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
         units,
     )?;
     let verification = if a.has("--verify") {
-        let mut vopts = VerifyOptions::default()
-            .with_scallop(opts.scallop_mm)
-            .with_gouge_tolerance(verify::gouge_tolerance_for(opts.chordal_mm))
-            .with_rest_area(rest);
-        if let Some(n) = a.count("--verify-samples")? {
-            vopts = vopts.with_samples(n);
-        }
         let cap = a
             .count("--verify-max-samples")?
             .unwrap_or(verify::PLAN_VERIFY_MAX_SAMPLES);
-        // Enough samples for the bound to prove the scallop: a quarter of it.
-        let v = verify::verify_to_bound_within(
-            &m.surface,
-            &CutterPath::from_toolpath(&path)?,
-            &vopts,
-            VERIFY_BOUND_SHARE * opts.scallop_mm,
-            cap,
-        )?;
+        let v = verify::verify_plan(&m, &planned, &opts, a.count("--verify-samples")?, cap)?;
         report.add_verification(&v);
         Some(v)
     } else {
@@ -444,10 +428,6 @@ fn compare_cmd(args: &[String]) -> Result<String> {
         serde_json::to_string_pretty(&c).expect("comparison serialises") + "\n"
     })
 }
-
-/// The error bound a plan's verification aims for, as a share of the scallop height: a
-/// bound well below the scallop is what makes the measurement prove it.
-pub const VERIFY_BOUND_SHARE: f64 = 0.25;
 
 fn verify_cmd(args: &[String]) -> Result<String> {
     let a = parse(

@@ -3,8 +3,10 @@
 //! detours as eq. 10–13 state them, and the cut checked by the cutting simulation — with
 //! the plain curve as the baseline the paper improves on.
 
+mod support;
+
 use std::collections::{HashMap, HashSet};
-use tspath::io;
+use support::{holed_samples, isfc_opts as opts, public_tsm};
 use tspath::machine::{self, Dialect, JobInfo, Units};
 use tspath::model::samples;
 use tspath::plan::isfc::cells::{edge, Link};
@@ -13,36 +15,12 @@ use tspath::plan::{self, MoveKind, PlanOptions, Strategy};
 use tspath::verify::{self, CutterPath, VerifyOptions};
 use tspath::Model;
 
-fn opts(r: f64, h: f64) -> PlanOptions {
-    let mut o = PlanOptions::default()
-        .with_tool_radius(r)
-        .with_scallop(h)
-        .with_strategy(Strategy::Isfc);
-    o.max_tilt_deg = 0.0;
-    o
-}
-
-fn public_tsm(name: &str) -> Model {
-    let path = format!("{}/www/models/grapetec/{name}", env!("CARGO_MANIFEST_DIR"));
-    io::load(&std::fs::read(path).unwrap(), name).unwrap()
-}
-
 /// The models of the loop test: two samples with holes and the two .tsm fixtures.
 fn loop_models() -> Vec<(&'static str, Model, PlanOptions)> {
-    vec![
-        (
-            "plate-hole",
-            samples::load_sample("plate-hole").unwrap(),
-            opts(1.0, 0.05),
-        ),
-        (
-            "bumps-hole",
-            samples::load_sample("bumps-hole").unwrap(),
-            opts(1.0, 0.05),
-        ),
-        ("mouse.tsm", public_tsm("mouse.tsm"), opts(1.0, 0.1)),
-        ("face.tsm", public_tsm("face.tsm"), opts(1.0, 0.1)),
-    ]
+    let mut m = holed_samples();
+    m.push(("mouse.tsm", public_tsm("mouse.tsm"), opts(1.0, 0.1)));
+    m.push(("face.tsm", public_tsm("face.tsm"), opts(1.0, 0.1)));
+    m
 }
 
 #[test]
@@ -283,19 +261,7 @@ fn corner_detours_are_g1_at_q_cross_the_diagonal_square_and_stay_in_their_square
 fn verified(m: &Model, o: &PlanOptions) -> (tspath::plan::PlanReport, verify::Verification) {
     let planned = plan::plan(m, o, &mut |_| true).unwrap();
     let mut report = planned.report(o);
-    let vo = VerifyOptions::default()
-        .with_scallop(o.scallop_mm)
-        .with_gouge_tolerance(verify::gouge_tolerance_for(o.chordal_mm))
-        .with_rest_area(planned.rest_rects(m))
-        .with_samples(200_000);
-    let v = verify::verify_to_bound_within(
-        &m.surface,
-        &CutterPath::from_toolpath(&planned.toolpath).unwrap(),
-        &vo,
-        0.25 * o.scallop_mm,
-        4_000_000,
-    )
-    .unwrap();
+    let v = verify::verify_plan(m, &planned, o, Some(200_000), 4_000_000).unwrap();
     report.add_verification(&v);
     (report, v)
 }

@@ -3,21 +3,15 @@
 //! per tree link between the centres of the cells it joins, and the layer a plan keeps is the
 //! layer of the curve it was planned from.
 
+mod support;
+
 use std::collections::HashMap;
+use support::{holed_samples, isfc_opts as opts};
 use tspath::model::samples;
 use tspath::plan::isfc::layer::{Layer, SEGMENT_FLOATS};
 use tspath::plan::isfc::{curve, Curve};
-use tspath::plan::{self, PlanOptions, Strategy};
+use tspath::plan::{self, Strategy};
 use tspath::Model;
-
-fn opts(r: f64, h: f64) -> PlanOptions {
-    let mut o = PlanOptions::default()
-        .with_tool_radius(r)
-        .with_scallop(h)
-        .with_strategy(Strategy::Isfc);
-    o.max_tilt_deg = 0.0;
-    o
-}
 
 fn point(a: &[f32]) -> [f32; 3] {
     [a[0], a[1], a[2]]
@@ -142,18 +136,7 @@ fn check_layer(name: &str, c: &Curve, layer: &Layer) -> usize {
 
 #[test]
 fn cells_and_tree_segments_are_the_curves() {
-    for (name, m, o) in [
-        (
-            "plate-hole",
-            samples::load_sample("plate-hole").unwrap(),
-            opts(1.0, 0.05),
-        ),
-        (
-            "bumps-hole",
-            samples::load_sample("bumps-hole").unwrap(),
-            opts(1.0, 0.05),
-        ),
-    ] {
+    for (name, m, o) in holed_samples() {
         let c = curve(&m, &o, &mut |_| true).unwrap();
         let layer = Layer::of(&c);
         let across = check_layer(name, &c, &layer);

@@ -6,13 +6,13 @@
 
 mod support;
 
-use support::{dense_samples, tool_clearance, SampleGrid};
+use support::{dense_samples, public_tsm, tool_clearance, SampleGrid};
 use tspath::geom::{Point3, Vector3};
 use tspath::io;
 use tspath::machine::{self, Dialect, JobInfo, Units};
 use tspath::model::samples;
 use tspath::plan::{isoparametric, PlanOptions, PlanStatus, Planned};
-use tspath::verify::{self, gcode::read_tool_poses, CutterPath, VerifyOptions};
+use tspath::verify::{self, gcode::read_tool_poses};
 use tspath::Model;
 
 /// A closed torus cage (Catmull–Clark): `m` × `n` quads on a torus of radii `big` and `small`
@@ -202,16 +202,11 @@ fn plan_and_verify(
 ) -> (Planned, tspath::plan::PlanReport, verify::Verification) {
     let planned = isoparametric::plan(m, opts, &mut |_| true).unwrap();
     let mut report = planned.report(opts);
-    let vo = VerifyOptions::default()
-        .with_scallop(opts.scallop_mm)
-        .with_gouge_tolerance(verify::gouge_tolerance_for(opts.chordal_mm))
-        .with_rest_area(planned.rest_rects(m))
-        .with_samples(200_000);
-    let v = verify::verify_to_bound_within(
-        &m.surface,
-        &CutterPath::from_toolpath(&planned.toolpath).unwrap(),
-        &vo,
-        0.25 * opts.scallop_mm,
+    let v = verify::verify_plan(
+        m,
+        &planned,
+        opts,
+        Some(200_000),
         verify::PLAN_VERIFY_MAX_SAMPLES,
     )
     .unwrap();
@@ -305,12 +300,6 @@ fn open_cages_with_sharp_boundaries_triangles_and_an_overhang_plan_without_gouge
             );
         }
     }
-}
-
-/// The public `.tsm` files (GrapeTec/T-SPLINE, LGPL-3.0; www/models/grapetec).
-fn public_tsm(name: &str) -> Model {
-    let path = format!("{}/www/models/grapetec/{name}", env!("CARGO_MANIFEST_DIR"));
-    io::load(&std::fs::read(&path).unwrap(), name).unwrap()
 }
 
 #[test]

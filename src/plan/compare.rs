@@ -10,7 +10,7 @@ use super::draft::Footprint;
 use super::{plan, PlanOptions, PlanStatus, Strategy};
 use crate::error::Result;
 use crate::model::Model;
-use crate::verify::{self, CutterPath, VerifyOptions};
+use crate::verify;
 use serde::{Deserialize, Serialize};
 
 /// Midpoint-rule cells per patch side for the surface area.
@@ -101,18 +101,7 @@ pub fn compare(
             gouges: None,
         };
         if let Some(max) = verify_max_samples {
-            let vo = VerifyOptions::default()
-                .with_scallop(h)
-                .with_gouge_tolerance(verify::gouge_tolerance_for(o.chordal_mm))
-                .with_rest_area(planned.rest_rects(model))
-                .with_samples(FIRST_SAMPLES.min(max));
-            let v = verify::verify_to_bound_within(
-                &model.surface,
-                &CutterPath::from_toolpath(&planned.toolpath)?,
-                &vo,
-                0.25 * h,
-                max,
-            )?;
+            let v = verify::verify_plan(model, &planned, &o, Some(FIRST_SAMPLES.min(max)), max)?;
             report.add_verification(&v);
             run.status = report.status;
             run.max_scallop_mm = Some(v.max_scallop_mm);

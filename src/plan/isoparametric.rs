@@ -606,9 +606,8 @@ pub fn plan(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Planned> {
-    let d = draft(model, opts, &mut |f| progress(DRAFT_SHARE * f))?;
-    super::pipeline::finish(model, d, opts, &mut |f| {
-        progress(DRAFT_SHARE + (1.0 - DRAFT_SHARE) * f)
+    super::pipeline::plan_with(model, opts, progress, DRAFT_SHARE, |p| {
+        draft(model, opts, p)
     })
 }
 

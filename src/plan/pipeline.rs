@@ -60,6 +60,21 @@ pub struct Planned {
     pub isfc_layer: Option<super::isfc::layer::Layer>,
 }
 
+/// Plans with a strategy: `draft` makes its draft, reporting on the first `draft_share` of
+/// `progress`, and the pipeline finishes it on the rest.
+pub fn plan_with(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+    draft_share: f64,
+    draft: impl FnOnce(&mut dyn FnMut(f64) -> bool) -> Result<Draft>,
+) -> Result<Planned> {
+    let d = draft(&mut |f| progress(draft_share * f))?;
+    finish(model, d, opts, &mut |f| {
+        progress(draft_share + (1.0 - draft_share) * f)
+    })
+}
+
 /// Runs the pipeline on `draft`. `progress` receives the fraction of this part done and
 /// returns `false` to cancel.
 pub fn finish(

@@ -50,30 +50,23 @@ pub struct FaceSurface {
     pub form: FaceForm,
 }
 
-fn locate(breaks: &[f64], x: f64) -> (usize, f64, f64) {
+/// The cell of `breaks` holding `x` (the upper one on a break).
+fn cell_of(breaks: &[f64], x: f64) -> usize {
     let n = breaks.len() - 1;
-    let i = breaks[1..n].partition_point(|&b| b <= x).min(n - 1);
+    breaks[1..n].partition_point(|&b| b <= x).min(n - 1)
+}
+
+/// `x` in cell `i` of `breaks`: its local parameter and the cell's scale `1 / span`.
+fn local(breaks: &[f64], i: usize, x: f64) -> (f64, f64) {
     let span = breaks[i + 1] - breaks[i];
-    (i, (x - breaks[i]) / span, 1.0 / span)
+    ((x - breaks[i]) / span, 1.0 / span)
 }
 
 impl FaceSurface {
     /// Point and derivatives at `(u, v)` in `[0,1]²`.
     pub fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
-        match &self.form {
-            FaceForm::Grid {
-                u_breaks,
-                v_breaks,
-                cells,
-            } => {
-                let (i, tu, su) = locate(u_breaks, u);
-                let (j, tv, sv) = locate(v_breaks, v);
-                cells[j * (u_breaks.len() - 1) + i]
-                    .derivs(tu, tv)
-                    .scaled(su, sv)
-            }
-            FaceForm::Tree(node) => node.derivs(u, v),
-        }
+        let (ub, vb) = self.breaks();
+        self.derivs_in([cell_of(ub, u), cell_of(vb, v)], u, v)
     }
 
     /// The lines `u = const` and `v = const` (from 0 to 1) between which the face is one
@@ -102,12 +95,9 @@ impl FaceSurface {
                     cell[0].min(u_breaks.len() - 2),
                     cell[1].min(v_breaks.len() - 2),
                 );
-                let (su, sv) = (
-                    1.0 / (u_breaks[i + 1] - u_breaks[i]),
-                    1.0 / (v_breaks[j + 1] - v_breaks[j]),
-                );
+                let ((tu, su), (tv, sv)) = (local(u_breaks, i, u), local(v_breaks, j, v));
                 cells[j * (u_breaks.len() - 1) + i]
-                    .derivs((u - u_breaks[i]) * su, (v - v_breaks[j]) * sv)
+                    .derivs(tu, tv)
                     .scaled(su, sv)
             }
             FaceForm::Tree(node) => node.derivs(u, v),
@@ -122,8 +112,8 @@ impl FaceSurface {
                 v_breaks,
                 cells,
             } => {
-                let (i, tu, _) = locate(u_breaks, u);
-                let (j, tv, _) = locate(v_breaks, v);
+                let (i, j) = (cell_of(u_breaks, u), cell_of(v_breaks, v));
+                let ((tu, _), (tv, _)) = (local(u_breaks, i, u), local(v_breaks, j, v));
                 cells[j * (u_breaks.len() - 1) + i].subs(tu, tv)
             }
             FaceForm::Tree(node) => node.subs(u, v),

@@ -37,6 +37,8 @@ pub use cutter::{CutterLocation, CutterPath, ToolTip};
 pub use rest::RestRect;
 
 use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::plan::{PlanOptions, Planned};
 use crate::surface::tessellate::Tessellation;
 use crate::surface::Surface;
 use serde::{Deserialize, Serialize};
@@ -109,6 +111,41 @@ const MAX_SAMPLES: usize = 50_000_000;
 /// told otherwise: the same for the CLI's `plan --verify` and the page, so both measure a
 /// plan alike (8 M samples: about 40 s in a browser tab, 130 MB).
 pub const PLAN_VERIFY_MAX_SAMPLES: usize = 8_000_000;
+/// The error bound a plan's verification aims for, as a share of the scallop height: a
+/// bound well below the scallop is what makes the measurement prove it.
+pub const PLAN_BOUND_SHARE: f64 = 0.25;
+
+/// How a plan made with `opts` is checked: its scallop, the gouge tolerance its chordal
+/// tolerance allows ([`gouge_tolerance_for`]), and its rest area `rest` measured apart.
+pub fn plan_options(opts: &PlanOptions, rest: Vec<RestRect>) -> VerifyOptions {
+    VerifyOptions::default()
+        .with_scallop(opts.scallop_mm)
+        .with_gouge_tolerance(gouge_tolerance_for(opts.chordal_mm))
+        .with_rest_area(rest)
+}
+
+/// Simulates the cut of `planned` (made with `opts`) as `plan --verify` and the page do,
+/// with [`plan_options`]: from `samples` (default [`VerifyOptions`]'s) until the error
+/// bound is [`PLAN_BOUND_SHARE`] of the scallop, with at most `max_samples`.
+pub fn verify_plan(
+    model: &Model,
+    planned: &Planned,
+    opts: &PlanOptions,
+    samples: Option<usize>,
+    max_samples: usize,
+) -> Result<Verification> {
+    let mut vo = plan_options(opts, planned.rest_rects(model));
+    if let Some(n) = samples {
+        vo = vo.with_samples(n);
+    }
+    verify_to_bound_within(
+        &model.surface,
+        &CutterPath::from_toolpath(&planned.toolpath)?,
+        &vo,
+        PLAN_BOUND_SHARE * opts.scallop_mm,
+        max_samples,
+    )
+}
 
 impl VerifyOptions {
     /// Sets the number of samples.

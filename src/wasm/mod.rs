@@ -556,10 +556,7 @@ impl WasmModel {
         options: JsValue,
     ) -> Result<WasmVerification, JsError> {
         let (bound, max_samples) = bound_options(&options)?;
-        let base = VerifyOptions::default()
-            .with_scallop(plan.opts.scallop_mm)
-            .with_gouge_tolerance(verify::gouge_tolerance_for(plan.opts.chordal_mm))
-            .with_rest_area(plan.rest_rects.clone());
+        let base = verify::plan_options(&plan.opts, plan.rest_rects.clone());
         let opts = verify_options(base, options)?;
         let path = CutterPath::from_toolpath(&plan.path).map_err(js_err)?;
         let t0 = now_ms();

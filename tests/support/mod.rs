@@ -1,11 +1,38 @@
-//! Independent clearance checks shared by the planner tests: dense samples of the surface
-//! (from a fine tessellation, without the planner's own obstacle index) and signed distances
-//! from them to the ball, shank and holder of a tool pose.
+//! Shared by the planner tests: the public `.tsm` files, the space-filling curve's models
+//! and options, and independent clearance checks — dense samples of the surface (from a
+//! fine tessellation, without the planner's own obstacle index) and signed distances from
+//! them to the ball, shank and holder of a tool pose.
 #![allow(dead_code)]
 
 use tspath::geom::{Point3, Vector3};
-use tspath::plan::PlanOptions;
+use tspath::io;
+use tspath::model::samples;
+use tspath::plan::{PlanOptions, Strategy};
 use tspath::Model;
+
+/// A public `.tsm` file (GrapeTec/T-SPLINE, LGPL-3.0; www/models/grapetec).
+pub fn public_tsm(name: &str) -> Model {
+    let path = format!("{}/www/models/grapetec/{name}", env!("CARGO_MANIFEST_DIR"));
+    io::load(&std::fs::read(&path).unwrap(), name).unwrap()
+}
+
+/// The space-filling curve, three-axis, ball `r`, scallop `h` (mm).
+pub fn isfc_opts(r: f64, h: f64) -> PlanOptions {
+    let mut o = PlanOptions::default()
+        .with_tool_radius(r)
+        .with_scallop(h)
+        .with_strategy(Strategy::Isfc);
+    o.max_tilt_deg = 0.0;
+    o
+}
+
+/// The built-in samples with holes, with the curve at r 1 mm, h 0.05 mm.
+pub fn holed_samples() -> Vec<(&'static str, Model, PlanOptions)> {
+    ["plate-hole", "bumps-hole"]
+        .into_iter()
+        .map(|n| (n, samples::load_sample(n).unwrap(), isfc_opts(1.0, 0.05)))
+        .collect()
+}
 
 /// Samples at most 0.3 mm apart on a tessellation within 0.01 mm of the surface: a cylinder
 /// of radius r can sink between them by 0.3² / 8r (0.011 mm for a 1 mm shank).

@@ -88,6 +88,26 @@ pub struct Link {
     pub cost: f64,
 }
 
+impl Link {
+    /// The link of cells `a` and `b` whose edges `p`–`q` and `r`–`s` face each other, `p`
+    /// opposite `r` (the bridges `p`–`r` and `q`–`s` do not cross).
+    pub fn facing(
+        v: &[Vertex],
+        w: Weights,
+        (a, [p, q]): (u32, [u32; 2]),
+        (b, [r, s]): (u32, [u32; 2]),
+    ) -> Link {
+        Link {
+            a,
+            b,
+            edge_a: edge(p, q),
+            edge_b: edge(r, s),
+            bridges: [edge(p, r), edge(q, s)],
+            cost: link_cost(v, p, q, r, s, w),
+        }
+    }
+}
+
 /// Weights of eq. 9: length change and tool-axis change.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Weights {
@@ -158,6 +178,7 @@ pub fn links_within(
     for (gi, g) in grids.iter().enumerate() {
         let (ni, nj) = g.cells();
         let cell = |ci: usize, cj: usize| first[gi] + (cj * ni + ci) as u32;
+        let link = |a, b, pq, rs| Link::facing(v, w, (a, pq), (b, rs));
         for cj in 0..nj {
             for ci in 0..ni {
                 let a = cell(ci, cj);
@@ -166,27 +187,13 @@ pub fn links_within(
                     let b = cell(ci + 1, cj);
                     let d = cells[b as usize].corners;
                     // A's right edge c1–c2 faces B's left edge d0–d3.
-                    out.push(Link {
-                        a,
-                        b,
-                        edge_a: edge(c[1], c[2]),
-                        edge_b: edge(d[0], d[3]),
-                        bridges: [edge(c[1], d[0]), edge(c[2], d[3])],
-                        cost: link_cost(v, c[1], c[2], d[0], d[3], w),
-                    });
+                    out.push(link(a, b, [c[1], c[2]], [d[0], d[3]]));
                 }
                 if cj + 1 < nj {
                     let b = cell(ci, cj + 1);
                     let d = cells[b as usize].corners;
                     // A's top edge c3–c2 faces B's bottom edge d0–d1.
-                    out.push(Link {
-                        a,
-                        b,
-                        edge_a: edge(c[3], c[2]),
-                        edge_b: edge(d[0], d[1]),
-                        bridges: [edge(c[3], d[0]), edge(c[2], d[1])],
-                        cost: link_cost(v, c[3], c[2], d[0], d[1], w),
-                    });
+                    out.push(link(a, b, [c[3], c[2]], [d[0], d[1]]));
                 }
             }
         }
@@ -273,14 +280,7 @@ pub fn links_across(
             } else {
                 (q2, q1)
             };
-            out.push(Link {
-                a,
-                b,
-                edge_a: edge(p1, p2),
-                edge_b: edge(q1, q2),
-                bridges: [edge(p1, r1), edge(p2, r2)],
-                cost: link_cost(v, p1, p2, r1, r2, w),
-            });
+            out.push(Link::facing(v, w, (a, [p1, p2]), (b, [r1, r2])));
         }
     }
     out

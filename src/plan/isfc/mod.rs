@@ -34,7 +34,7 @@ use super::pipeline::Planned;
 use super::stepover::FeedDir;
 use super::PlanOptions;
 use crate::error::{Error, Result};
-use crate::geom::{Point3, Vector3};
+use crate::geom::{Aabb, Point3, Vector3};
 use crate::layout::ConnectionKind;
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
@@ -107,11 +107,13 @@ pub fn plan(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Planned> {
-    let (d, layer) = draft_and_layer(model, opts, &mut |f| progress(DRAFT_SHARE * f))?;
-    let mut planned = super::pipeline::finish(model, d, opts, &mut |f| {
-        progress(DRAFT_SHARE + (1.0 - DRAFT_SHARE) * f)
+    let mut layer = None;
+    let mut planned = super::pipeline::plan_with(model, opts, progress, DRAFT_SHARE, |p| {
+        let (d, l) = draft_and_layer(model, opts, p)?;
+        layer = Some(l);
+        Ok(d)
     })?;
-    planned.isfc_layer = Some(layer);
+    planned.isfc_layer = layer;
     Ok(planned)
 }
 
@@ -138,7 +140,7 @@ pub fn curve(
     let views = patch_views(model);
 
     // Sides a patch shares with another (0: v = 0, 1: u = 1, 2: v = 1, 3: u = 0).
-    let shared = shared_sides(model, &views)?;
+    let shared = shared_sides(model, &views);
     let mut free = vec![[true; 4]; np];
     for &(a, sa, b, sb) in &shared {
         free[a as usize][sa as usize] = false;
@@ -372,7 +374,7 @@ const SIDE_MATCH_REL: f64 = 1e-6;
 /// 1: `u = 1`, 2: `v = 1`, 3: `u = 0`): the layout's side connections, and sides that lie on
 /// each other in space although the layout has a strip of zero width between them (a
 /// crease's repeated knots), wholly or in part.
-fn shared_sides(model: &Model, views: &[PatchView]) -> Result<Vec<(u32, u8, u32, u8)>> {
+fn shared_sides(model: &Model, views: &[PatchView]) -> Vec<(u32, u8, u32, u8)> {
     let mut out: Vec<(u32, u8, u32, u8)> = model
         .layout
         .connections
@@ -393,7 +395,7 @@ fn shared_sides(model: &Model, views: &[PatchView]) -> Result<Vec<(u32, u8, u32,
         2 => [t, 1.0],
         _ => [0.0, t],
     };
-    // Each side as a polyline.
+    // Each side as a polyline, with its box and its longest chord.
     let curves: Vec<[Vec<Point3>; 4]> = views
         .iter()
         .map(|v| {
@@ -407,37 +409,54 @@ fn shared_sides(model: &Model, views: &[PatchView]) -> Result<Vec<(u32, u8, u32,
             })
         })
         .collect();
-    let near_curve = |p: &Point3, c: &[Point3]| {
+    let boxes: Vec<[(Aabb, f64); 4]> = curves
+        .iter()
+        .map(|sides| {
+            std::array::from_fn(|k| {
+                let mut b = Aabb::empty();
+                sides[k].iter().for_each(|p| b.grow(p));
+                let chord = sides[k]
+                    .windows(2)
+                    .map(|w| (w[1] - w[0]).norm())
+                    .fold(0.0, f64::max);
+                (b, chord)
+            })
+        })
+        .collect();
+    let near_curve = |p: &Point3, c: &[Point3], within: f64| {
         c.windows(2)
-            .map(|w| dist_to_segment(p, &w[0], &w[1]))
-            .fold(f64::INFINITY, f64::min)
+            .any(|w| dist_to_segment(p, &w[0], &w[1]) <= within)
     };
     let np = views.len();
     for a in 0..np {
         for b in a + 1..np {
             for sa in 0..4u8 {
                 for sb in 0..4u8 {
+                    // Interior samples of a's side lying on b's side (the chords of b's
+                    // polyline are within a twentieth of a chord of it): only where the
+                    // sides' boxes come that close.
+                    let ((box_a, chord_a), (box_b, chord_b)) =
+                        (&boxes[a][sa as usize], &boxes[b][sb as usize]);
+                    let within = tol + 0.05 * chord_a.max(*chord_b);
+                    if (0..3).any(|k| {
+                        box_a.min[k] > box_b.max[k] + within || box_b.min[k] > box_a.max[k] + within
+                    }) {
+                        continue;
+                    }
                     if out.iter().any(|&(x, xs, y, ys)| {
                         (x as usize, xs, y as usize, ys) == (a, sa, b, sb)
                             || (x as usize, xs, y as usize, ys) == (b, sb, a, sa)
                     }) {
                         continue;
                     }
-                    // Interior samples of a's side lying on b's side (the chords of b's
-                    // polyline are within a twentieth of a chord of it).
                     let ca = &curves[a][sa as usize];
                     let cb = &curves[b][sb as usize];
                     let step = SIDE_CURVE_SAMPLES / (SIDE_SAMPLES + 1);
-                    let chord = ca
-                        .windows(2)
-                        .chain(cb.windows(2))
-                        .map(|w| (w[1] - w[0]).norm())
-                        .fold(0.0, f64::max);
                     let on = (1..=SIDE_SAMPLES)
-                        .filter(|&k| near_curve(&ca[k * step], cb) <= tol + 0.05 * chord)
+                        .filter(|&k| near_curve(&ca[k * step], cb, within))
                         .count();
                     let back = (1..=SIDE_SAMPLES)
-                        .filter(|&k| near_curve(&cb[k * step], ca) <= tol + 0.05 * chord)
+                        .filter(|&k| near_curve(&cb[k * step], ca, within))
                         .count();
                     if on >= 2 && back >= 2 {
                         out.push((a as u32, sa, b as u32, sb));
@@ -446,7 +465,7 @@ fn shared_sides(model: &Model, views: &[PatchView]) -> Result<Vec<(u32, u8, u32,
             }
         }
     }
-    Ok(out)
+    out
 }
 
 /// Cells with a corner on a line the parity repair added.
@@ -611,38 +630,32 @@ impl Ctx<'_> {
     fn emit_edge(&self, out: &mut DraftBuilder, a: u32, b: u32, last: Footprint) -> Result<()> {
         let (va, vb) = (&self.vertices[a as usize], &self.vertices[b as usize]);
         if va.patch == vb.patch {
-            let (x, y) = (va.uv, vb.uv);
-            let line = move |t: f64| [x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t];
-            return self.emit_curve(out, va.patch, &line, last);
+            return self.emit_line(out, va.patch, va.uv, vb.uv, last);
         }
         // Across a shared side: from `a` to its foot on the side nearest `b`, then from the
         // foot of `b` on its patch's side nearest `a` to `b`.
         let fa = self.foot(va, &vb.cc)?;
         let fb = self.foot(vb, &va.cc)?;
-        let (x, y) = (va.uv, fa);
-        self.emit_curve(
-            out,
-            va.patch,
-            &move |t| [x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t],
-            Footprint::NONE,
-        )?;
+        self.emit_line(out, va.patch, va.uv, fa, Footprint::NONE)?;
         // The feet need not meet (the grids of the two patches differ): along the side
         // from `a`'s foot to the point of it facing `b`'s, not straight across the surface.
         let side_b = self.patch_point(vb.patch, fb)?.cc;
-        let (x, y) = (fa, self.along_side(va.patch, fa, &side_b)?);
-        self.emit_curve(
-            out,
-            va.patch,
-            &move |t| [x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t],
-            Footprint::NONE,
-        )?;
-        let (x, y) = (fb, vb.uv);
-        self.emit_curve(
-            out,
-            vb.patch,
-            &move |t| [x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t],
-            last,
-        )
+        let facing = self.along_side(va.patch, fa, &side_b)?;
+        self.emit_line(out, va.patch, fa, facing, Footprint::NONE)?;
+        self.emit_line(out, vb.patch, fb, vb.uv, last)
+    }
+
+    /// [`Ctx::emit_curve`] along the straight parameter line from `x` to `y`.
+    fn emit_line(
+        &self,
+        out: &mut DraftBuilder,
+        patch: u32,
+        x: [f64; 2],
+        y: [f64; 2],
+        last: Footprint,
+    ) -> Result<()> {
+        let line = move |t: f64| [x[0] + (y[0] - x[0]) * t, x[1] + (y[1] - x[1]) * t];
+        self.emit_curve(out, patch, &line, last)
     }
 
     /// The point of `v`'s patch side straight out from `v` (along its grid line) that lies
