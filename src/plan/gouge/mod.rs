@@ -1,0 +1,268 @@
+//! Ball-centre gouge check against the whole surface.
+//!
+//! A CL point is placed by its own face's normal (`cl_point = cc + r·n`). Where the surface is
+//! creased inward (C0 knot lines, e.g. those a `.tsm` grip block puts in) or another part of
+//! the surface comes within the ball, that ball cuts into the neighbouring face. This module
+//! owns finding such CL points and lifting them clear: the ball centre moves away from the
+//! nearest surface point until it is a radius from every face, so it touches both sides of
+//! the crease. It must not move a CL point that gouges nothing (tolerance below), nor change
+//! moves off the surface. Only balls near a spot where the surface is tighter than the ball,
+//! creased or singular ([`spots`]) are checked, against every face within reach there; where
+//! other parts of a smooth surface come within the ball (thin walls) is not looked for.
+
+mod nearest;
+mod spots;
+
+use super::{Move, MoveKind, Toolpath};
+use crate::error::{Error, Result};
+use crate::geom::Point3;
+use crate::model::Model;
+use crate::tmesh::{Scheme, TMesh};
+use nearest::Nearest;
+use spots::Spots;
+
+/// What the check found.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GougeStats {
+    /// CL points lifted because the ball cut into the surface.
+    pub lifted: usize,
+    /// Deepest cut found before lifting (mm).
+    pub worst_mm: f64,
+    /// The CL point of that deepest cut, before lifting (mm).
+    pub worst_at: Option<Point3>,
+    /// CL points still closer than a radius after the lifting rounds (mm deep at most
+    /// `residual_mm`).
+    pub residual: usize,
+    pub residual_mm: f64,
+    /// Cut points added between two cut points where the ball, moving straight from one to
+    /// the other, cut into the surface (a fold or crease between them); they are lifted too.
+    pub inserted: usize,
+}
+
+/// Lifting rounds per CL point (each moves it away from the then nearest point).
+const LIFT_ROUNDS: usize = 8;
+/// Moves between two checks for cancellation.
+const CANCEL_EVERY: usize = 256;
+
+/// True if the surface may have C0 knot lines (creases): only repeated knots, that is zero
+/// knot intervals, put them in a T-spline; Catmull–Clark limit surfaces are G1 everywhere.
+pub fn may_crease(mesh: &TMesh) -> bool {
+    mesh.scheme() == Scheme::TSpline && mesh.half_edges().iter().any(|h| h.knot == 0.0)
+}
+
+/// True if a ball of radius `r` placed by its contact normal may cut into the surface
+/// elsewhere: the surface may crease, or somewhere it is concave (towards the tool) with a
+/// radius below the ball's (within [`TIGHT_MARGIN`]). The planner runs [`lift`] only then
+/// (it costs about as much as the rest of a keycap plan).
+pub fn needed(model: &Model, r: f64) -> bool {
+    may_crease(&model.mesh)
+        || model
+            .smallest_concave_radius()
+            .is_some_and(|c| c.radius_mm < r * (1.0 + TIGHT_MARGIN))
+}
+
+/// Relative margin on the tool radius below which a concave radius counts as tight: the
+/// smallest radius is sampled, and may lie lower between samples.
+const TIGHT_MARGIN: f64 = 0.25;
+
+/// Lifts every cutting CL point of `path` near a spot (see [`spots`]) whose ball of radius `r`
+/// cuts into the surface by more than `tol` mm, until it is a radius from the nearest surface point (within `tol`).
+/// The contact point becomes that nearest point; `left[i]` becomes the material the lifted
+/// ball leaves at move `i`'s old contact point (mm; untouched for moves not lifted).
+/// Then the straight moves next to lifted points, and those over which the ball turns round
+/// a convex crease, are checked between their ends: where the ball cuts in on the way, a
+/// lifted cut point is added half-way (and the halves checked again, [`SEGMENT_HALVINGS`] deep). Returns what it did and, when points were added, for
+/// every move of the new path the old move it is (`u32::MAX` for added ones; empty when
+/// nothing was added). `keep_going` is asked every few hundred moves; false cancels.
+pub fn lift(
+    model: &Model,
+    path: &mut Toolpath,
+    r: f64,
+    tol: f64,
+    left: &mut [f64],
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Result<(GougeStats, Vec<u32>)> {
+    let near = Nearest::new(&model.surface);
+    let spots = Spots::new(model, &near, r, tol);
+    // Where a move's contact point is on the surface: the face and its parameters there.
+    let hint = |m: &Move, q: [f64; 2]| {
+        let patch = model.layout.patches.get(m.patch as usize)?;
+        m.kind
+            .on_surface()
+            .then(|| patch.face_param(&model.surface, q[0], q[1]))
+    };
+    let mut stats = GougeStats::default();
+    let mut lifted = vec![false; path.moves.len()];
+    for (i, m) in path.moves.iter_mut().enumerate() {
+        if i % CANCEL_EVERY == 0 && !keep_going() {
+            return Err(Error::Cancelled);
+        }
+        if !matches!(m.kind, MoveKind::Feed | MoveKind::Link) || !spots.near(&m.cl_point) {
+            continue;
+        }
+        let Some(l) = lift_one(&near, m.cl_point, r, tol, &[], &mut stats) else {
+            continue;
+        };
+        lifted[i] = true;
+        if let Some(x) = left.get_mut(i) {
+            *x = ((l.centre - m.cc_point).norm() - r).max(0.0);
+        }
+        m.cl_point = l.centre;
+        m.cc_point = l.contact;
+    }
+    // Straight moves next to lifted points.
+    let n = path.moves.len();
+    let near_lifted = |i: usize| {
+        (i.saturating_sub(SEGMENT_REACH)..(i + SEGMENT_REACH + 1).min(n)).any(|k| lifted[k])
+    };
+    let mut added: Vec<Vec<(Move, [f64; 2])>> = vec![Vec::new(); n];
+    for i in 1..n {
+        if i % CANCEL_EVERY == 0 && !keep_going() {
+            return Err(Error::Cancelled);
+        }
+        let (a, b) = (&path.moves[i - 1], &path.moves[i]);
+        if !(a.kind.on_surface() && matches!(b.kind, MoveKind::Feed | MoveKind::Link)) {
+            continue;
+        }
+        // The ball turning round a convex crease between the two points: its centre moves
+        // on an arc round the crease, the straight move cuts the chord of that arc.
+        let turn = (a.cl_point - a.cc_point).angle(&(b.cl_point - b.cc_point));
+        let pivots = r * (1.0 - (0.5 * turn).cos()) > tol;
+        if !(pivots || near_lifted(i)) {
+            continue;
+        }
+        let (pa, pb) = (
+            path.params.get(i - 1).copied().unwrap_or_default(),
+            path.params.get(i).copied().unwrap_or_default(),
+        );
+        let mut out = Vec::new();
+        let hints: Vec<(u32, [f64; 2])> =
+            [hint(a, pa), hint(b, pb)].into_iter().flatten().collect();
+        split_segment(
+            &near,
+            (a, pa),
+            (b, pb),
+            (r, tol),
+            &hints,
+            SEGMENT_HALVINGS,
+            &mut stats,
+            &mut out,
+        );
+        stats.inserted += out.len();
+        added[i] = out;
+    }
+    if stats.inserted == 0 {
+        return Ok((stats, Vec::new()));
+    }
+    let mut origin = Vec::with_capacity(n + stats.inserted);
+    path.rebuild(|old, i, add| {
+        for (m, q) in &added[i] {
+            add(*m, *q);
+            origin.push(u32::MAX);
+        }
+        add(old.moves[i], old.param(i));
+        origin.push(i as u32);
+    });
+    Ok((stats, origin))
+}
+
+/// Moves on either side of a lifted point whose straight moves are checked between their ends.
+const SEGMENT_REACH: usize = 2;
+/// Most halvings of a straight move while adding lifted points on it.
+pub const SEGMENT_HALVINGS: usize = 6;
+/// Where between its ends a straight move is checked (fractions of it).
+const SEGMENT_PROBES: [f64; 3] = [0.5, 0.25, 0.75];
+
+/// A ball centre lifted clear of the surface, and the point it touches.
+struct Lifted {
+    centre: Point3,
+    contact: Point3,
+}
+
+/// Lifts the ball centred at `c` until it is a radius from the nearest surface point (within
+/// `tol`), if it cuts in by more than `tol`; `None` if it does not.
+fn lift_one(
+    near: &Nearest,
+    c: Point3,
+    r: f64,
+    tol: f64,
+    hints: &[(u32, [f64; 2])],
+    stats: &mut GougeStats,
+) -> Option<Lifted> {
+    let (d, q) = near.nearest_from(&c, r, hints)?;
+    if d >= r - tol {
+        return None;
+    }
+    if r - d > stats.worst_mm {
+        stats.worst_mm = r - d;
+        stats.worst_at = Some(c);
+    }
+    stats.lifted += 1;
+    let (mut c, mut nearest) = (c, (d, q));
+    let mut depth = r - d;
+    for round in 0..LIFT_ROUNDS {
+        let (d, q) = nearest;
+        c += (c - q) / d * depth;
+        let Some(next) = near.nearest_from(&c, r, hints) else {
+            break;
+        };
+        nearest = next;
+        depth = r - next.0;
+        if depth <= 0.1 * tol || round + 1 == LIFT_ROUNDS {
+            break;
+        }
+    }
+    if depth > tol {
+        stats.residual += 1;
+        stats.residual_mm = stats.residual_mm.max(depth);
+    }
+    Some(Lifted {
+        centre: c,
+        contact: nearest.1,
+    })
+}
+
+/// Adds to `out`, in order from `a` to `b`, lifted cut points where the ball moving straight
+/// from `a` to `b` cuts in by more than `tol`, checking the halves again up to `depth` deep.
+#[allow(clippy::too_many_arguments)]
+fn split_segment(
+    near: &Nearest,
+    a: (&Move, [f64; 2]),
+    b: (&Move, [f64; 2]),
+    (r, tol): (f64, f64),
+    hints: &[(u32, [f64; 2])],
+    depth: usize,
+    stats: &mut GougeStats,
+    out: &mut Vec<(Move, [f64; 2])>,
+) {
+    if depth == 0 {
+        return;
+    }
+    let (ma, mb) = (a.0, b.0);
+    let cuts_in = SEGMENT_PROBES.iter().any(|&s| {
+        let c = ma.cl_point + (mb.cl_point - ma.cl_point) * s;
+        near.nearest_from(&c, r, hints)
+            .is_some_and(|(d, _)| d < r - tol)
+    });
+    if !cuts_in {
+        return;
+    }
+    let mid = ma.cl_point + (mb.cl_point - ma.cl_point) * 0.5;
+    let (centre, contact) = match lift_one(near, mid, r, tol, hints, stats) {
+        Some(l) => (l.centre, l.contact),
+        None => (
+            mid,
+            near.nearest_from(&mid, r, hints)
+                .map_or(ma.cc_point, |(_, q)| q),
+        ),
+    };
+    let q = [0.5 * (a.1[0] + b.1[0]), 0.5 * (a.1[1] + b.1[1])];
+    let m = Move {
+        cl_point: centre,
+        cc_point: contact,
+        ..*mb
+    };
+    split_segment(near, a, (&m, q), (r, tol), hints, depth - 1, stats, out);
+    out.push((m, q));
+    split_segment(near, (&m, q), b, (r, tol), hints, depth - 1, stats, out);
+}
