@@ -363,3 +363,29 @@ fn the_public_tsm_files_plan_with_zero_gouges_and_keep_their_scallop_where_reach
             .any(|p| p.kind == "scallop" || p.kind == "gouge"));
     }
 }
+
+#[test]
+fn face_tsm_at_the_page_defaults_keeps_its_scallop_beside_lifted_balls() {
+    // Issue 13, 3: at r 0.5, h 0.01 mm face.tsm left 1.034 h at (−12.881, 12.192, 0.916) mm,
+    // between two balls lifted off the crease at a patch seam, outside the rest area: the
+    // search for the material lifted balls leave, on a 5 × 5 grid per footprint, missed
+    // that narrow peak. Now everything above h is in the rest area, and no gouge.
+    let m = public_tsm("face.tsm");
+    let opts = PlanOptions::default()
+        .with_tool_radius(0.5)
+        .with_scallop(0.01);
+    let (_, report, v) = plan_and_verify(&m, &opts);
+    println!(
+        "face.tsm r 0.5 h 0.01: max scallop {:.5} mm at {:?} (bound {:.5} mm, {} samples), rest {:.2} mm², gouges {}",
+        v.max_scallop_mm, v.max_scallop_at_mm, v.error_bound_mm, v.samples, report.unreachable_area_mm2, v.gouge_count
+    );
+    assert!(v.error_bound_mm <= 0.25 * opts.scallop_mm);
+    assert_eq!(v.gouge_count, 0);
+    assert!(
+        v.max_scallop_mm <= opts.scallop_mm,
+        "{} mm left outside the rest area at {:?}",
+        v.max_scallop_mm,
+        v.max_scallop_at_mm
+    );
+    assert!(!report.problems.iter().any(|p| p.kind == "scallop"));
+}
