@@ -612,6 +612,19 @@ fn bumps_hole() -> Result<TMesh> {
     cc_plate(15, 13, [80.0, 60.0], &holes, bumps_z)
 }
 
+/// A Catmull–Clark plate, 80 × 80 mm, with four round bosses (+3 mm, at x, y = ±20 mm) and
+/// a square hole between them, like seed 003's third surface; not a listed sample, used by
+/// the feature-region tests.
+pub fn four_bosses_hole() -> Result<TMesh> {
+    let holes = [(7, 7), (8, 7), (7, 8), (8, 8)];
+    cc_plate(17, 17, [80.0, 80.0], &holes, |x, y| {
+        [(-20.0, -20.0), (20.0, -20.0), (-20.0, 20.0), (20.0, 20.0)]
+            .iter()
+            .map(|&(cx, cy)| bump(x, y, cx, cy, 10.0, 3.0))
+            .sum()
+    })
+}
+
 fn waves() -> Result<TMesh> {
     let n = 13;
     clamped_plate(

@@ -19,6 +19,7 @@ pub mod pipeline;
 pub mod reach;
 pub mod stepover;
 pub mod toolpath;
+pub mod watershed;
 
 pub use options::{PlanOptions, Strategy};
 

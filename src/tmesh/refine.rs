@@ -49,6 +49,20 @@ impl TMesh {
 
     /// The global chart with face `start.face` placed at `start`.
     pub fn global_chart_from(&self, start: Placement) -> Option<GlobalChart> {
+        let faces = self.face_placements(start)?;
+        let nv = self.points.len();
+        let extraordinary: Vec<bool> = (0..nv as u32).map(|v| self.is_extraordinary(v)).collect();
+        if extraordinary.iter().any(|&e| e) {
+            return None;
+        }
+        self.chart_with(faces, &extraordinary)
+    }
+
+    /// Every face placed in one parameter chart, `start.face` at `start`, walking across
+    /// shared edges: `None` where the faces do not fit together in one plane (a tube, a
+    /// closed surface, an extraordinary point inside the domain). Extraordinary points on
+    /// the boundary, such as a hole's corners, are allowed.
+    pub fn face_placements(&self, start: Placement) -> Option<Vec<Placement>> {
         let nf = self.faces.len();
         let mut placed: Vec<Option<Placement>> = vec![None; nf];
         placed[start.face as usize] = Some(start);
@@ -89,12 +103,12 @@ impl TMesh {
                 }
             }
         }
-        let faces: Vec<Placement> = placed.into_iter().collect::<Option<_>>()?;
+        placed.into_iter().collect()
+    }
+
+    /// The chart from placed faces.
+    fn chart_with(&self, faces: Vec<Placement>, extraordinary: &[bool]) -> Option<GlobalChart> {
         let nv = self.points.len();
-        let extraordinary: Vec<bool> = (0..nv as u32).map(|v| self.is_extraordinary(v)).collect();
-        if extraordinary.iter().any(|&e| e) {
-            return None;
-        }
         let mut vertex_pos = vec![[0.0; 2]; nv];
         let mut knots = Vec::with_capacity(nv);
         for v in 0..nv as u32 {
@@ -104,7 +118,7 @@ impl TMesh {
             let r = rot(pl.quarter_turns, lo);
             let p = [r[0] + pl.offset[0], r[1] + pl.offset[1]];
             vertex_pos[v as usize] = p;
-            let (ks, kt) = self.local_knots(v, &extraordinary);
+            let (ks, kt) = self.local_knots(v, extraordinary);
             // The vertex frame's s runs along its reference half-edge, t a quarter turn on.
             let abs = |k: &LocalKnots, base: f64, sign: f64| -> LocalKnots {
                 let mut a = k.map(|x| base + sign * x);

@@ -1,0 +1,223 @@
+//! Watershed feature regions and optimised multi-rectangles (Liu et al. 2020, seed 003):
+//! the curvature map of the parameter domain ([`map`]), its segmentation into feature
+//! regions grown down from curvature peaks ([`regions`]) and the boxes that cover each
+//! region ([`boxes`]).
+//!
+//! Owns the feature analysis in the parameter domain; must not evaluate tool positions or
+//! change the model (refinement belongs to [`crate::tmesh::refine`]).
+
+pub mod boxes;
+pub mod map;
+pub mod regions;
+
+/// Values on a uniform grid, `i` along the first parameter (`s`), `j` along the second
+/// (`t`), stored row by row (`j * nx + i`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid<T> {
+    pub nx: usize,
+    pub ny: usize,
+    pub cells: Vec<T>,
+}
+
+impl<T: Copy> Grid<T> {
+    /// A grid of `nx × ny` points, all `value`.
+    pub fn filled(nx: usize, ny: usize, value: T) -> Self {
+        Grid {
+            nx,
+            ny,
+            cells: vec![value; nx * ny],
+        }
+    }
+
+    /// The value at `(i, j)`.
+    pub fn at(&self, i: usize, j: usize) -> T {
+        self.cells[j * self.nx + i]
+    }
+
+    /// Sets the value at `(i, j)`.
+    pub fn set(&mut self, i: usize, j: usize, value: T) {
+        self.cells[j * self.nx + i] = value;
+    }
+
+    /// The 4-neighbours of `(i, j)` inside the grid.
+    pub fn neighbours(&self, i: usize, j: usize) -> impl Iterator<Item = (usize, usize)> {
+        let (nx, ny) = (self.nx as isize, self.ny as isize);
+        [(-1isize, 0isize), (1, 0), (0, -1), (0, 1)]
+            .into_iter()
+            .map(move |(di, dj)| (i as isize + di, j as isize + dj))
+            .filter(move |&(x, y)| x >= 0 && y >= 0 && x < nx && y < ny)
+            .map(|(x, y)| (x as usize, y as usize))
+    }
+}
+
+use crate::error::Result;
+use crate::model::Model;
+
+/// Which way a feature region curves, seen from the tool.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeatureKind {
+    /// Bulging towards the tool (a boss): negative mean curvature at its marker.
+    Convex,
+    /// Hollow towards the tool (a dimple).
+    Concave,
+}
+
+/// A feature region of a model's curvature map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Feature {
+    pub region: regions::Region,
+    pub kind: FeatureKind,
+}
+
+/// The feature regions of a model: its curvature map, the label of every grid point and
+/// the regions with their kinds.
+#[derive(Debug, Clone)]
+pub struct Features {
+    pub map: map::CurvatureMap,
+    pub labels: Grid<u32>,
+    pub features: Vec<Feature>,
+    /// The background value used (1/mm).
+    pub background: f64,
+}
+
+/// The map's reference curvature is this quantile of its values: a few points next to an
+/// extraordinary point, where a Catmull–Clark surface's curvature runs away, do not set it.
+pub const REFERENCE_QUANTILE: f64 = 0.995;
+/// Share of the reference curvature below which grid points are background.
+pub const BACKGROUND_SHARE: f64 = 0.2;
+/// Regions whose marker (their highest point) stays below this share of the reference
+/// curvature are dropped to the background: the ring of opposite curvature round a boss's
+/// foot, and the rim of a dimple, rise only to about a third of the feature's own peak.
+pub const MARKER_SHARE: f64 = 0.5;
+/// Regions with fewer grid points than this share of the valid ones are dropped too.
+pub const MIN_REGION_SHARE: f64 = 0.01;
+
+/// The feature regions of `model` on a map of `per_unit` grid points per knot unit:
+/// regions grown from curvature peaks down to [`BACKGROUND_SHARE`] of the reference
+/// curvature ([`REFERENCE_QUANTILE`]), without those whose peak is below [`MARKER_SHARE`]
+/// of it or smaller than [`MIN_REGION_SHARE`] of the map, each classed by the sign of the
+/// mean curvature at its marker; the rest is background (label 0).
+pub fn features(model: &Model, per_unit: f64) -> Result<Features> {
+    let map = map::curvature_map(model, per_unit)?;
+    let mut values: Vec<f64> = map
+        .curvature
+        .cells
+        .iter()
+        .copied()
+        .filter(|c| c.is_finite())
+        .collect();
+    values.sort_by(f64::total_cmp);
+    let reference = values
+        .get(((values.len() as f64 - 1.0) * REFERENCE_QUANTILE).round() as usize)
+        .copied()
+        .unwrap_or(0.0);
+    let background = (BACKGROUND_SHARE * reference).max(f64::MIN_POSITIVE);
+    let (mut labels, regions) = regions::watershed(&map.curvature, &map.valid, background);
+    let min_points = (MIN_REGION_SHARE * values.len() as f64).ceil() as usize;
+    let mut relabel = vec![regions::BACKGROUND; regions.len() + 1];
+    let mut features = Vec::new();
+    for region in regions {
+        let (i, j) = region.marker;
+        if map.curvature.at(i, j) < MARKER_SHARE * reference || region.points < min_points {
+            continue;
+        }
+        let label = features.len() as u32 + 1;
+        relabel[region.label as usize] = label;
+        let kind = if map.mean.at(i, j) < 0.0 {
+            FeatureKind::Convex
+        } else {
+            FeatureKind::Concave
+        };
+        features.push(Feature {
+            region: regions::Region { label, ..region },
+            kind,
+        });
+    }
+    for l in labels.cells.iter_mut() {
+        *l = relabel[*l as usize];
+    }
+    Ok(Features {
+        map,
+        labels,
+        features,
+        background,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Point3;
+    use crate::model::samples;
+
+    /// The surface point of a feature's marker.
+    fn marker_point(m: &Model, f: &Features, k: usize) -> Point3 {
+        let (i, j) = f.features[k].region.marker;
+        let (face, [u, v]) = f.map.at.at(i, j).unwrap();
+        m.surface.subs(face as usize, u, v)
+    }
+
+    /// `bumps` (T-spline) and `bumps-hole` (Catmull–Clark, a hole between the two): one
+    /// convex region on the bump and one concave region on the dimple, markers on them; no
+    /// grid point of the hole is in a region.
+    #[test]
+    fn bumps_give_one_convex_and_one_concave_region() {
+        for name in ["bumps", "bumps-hole"] {
+            let m = samples::load_sample(name).unwrap();
+            let f = features(&m, map::DEFAULT_PER_UNIT).unwrap();
+            let kinds: Vec<FeatureKind> = f.features.iter().map(|x| x.kind).collect();
+            assert_eq!(kinds.len(), 2, "{name}: {kinds:?}");
+            for (k, feature) in f.features.iter().enumerate() {
+                let p = marker_point(&m, &f, k);
+                match feature.kind {
+                    // The bump's control points rise 4 mm round (−20, 0), the dimple's sink
+                    // 3 mm round (20, 2); the limit surface rises and sinks less.
+                    FeatureKind::Convex => {
+                        assert!(
+                            p.z > 2.0 && (p.x + 20.0).hypot(p.y) < 5.0,
+                            "{name}: convex at {p}"
+                        )
+                    }
+                    FeatureKind::Concave => {
+                        assert!(
+                            p.z < -1.5 && (p.x - 20.0).hypot(p.y - 2.0) < 5.0,
+                            "{name}: concave at {p}"
+                        )
+                    }
+                }
+            }
+            assert!(kinds.contains(&FeatureKind::Convex) && kinds.contains(&FeatureKind::Concave));
+            for (k, l) in f.labels.cells.iter().enumerate() {
+                if !f.map.valid.cells[k] {
+                    assert_eq!(*l, regions::BACKGROUND);
+                }
+            }
+        }
+    }
+
+    /// Four bosses round a hole (seed 003's third surface): four convex regions, one on
+    /// each boss.
+    #[test]
+    fn four_bosses_give_four_convex_regions() {
+        let m = Model::try_new(
+            "four bosses",
+            "test",
+            "mm",
+            samples::four_bosses_hole().unwrap(),
+        )
+        .unwrap();
+        let f = features(&m, map::DEFAULT_PER_UNIT).unwrap();
+        assert_eq!(f.features.len(), 4, "{:?}", f.features);
+        let mut centres: Vec<(i64, i64)> = (0..4)
+            .map(|k| {
+                assert_eq!(f.features[k].kind, FeatureKind::Convex);
+                let p = marker_point(&m, &f, k);
+                assert!(p.z > 1.5, "boss top at {p}");
+                ((p.x / 20.0).round() as i64, (p.y / 20.0).round() as i64)
+            })
+            .collect();
+        centres.sort();
+        assert_eq!(centres, vec![(-1, -1), (-1, 1), (1, -1), (1, 1)]);
+    }
+}
