@@ -519,6 +519,10 @@ fn place_component(
     Some(out)
 }
 
+/// Relative mismatch between a chart rectangle's area and the face parts inside it above
+/// which faces do not fill it.
+const RECT_FILL_REL: f64 = 1e-9;
+
 /// The chart rectangle `(min, max)` of a local rectangle under a placement.
 fn chart_rect(r: &[f64; 4], (k, off): Placement) -> ([f64; 2], [f64; 2]) {
     let a = rot(k, [r[0], r[2]]);
@@ -550,7 +554,59 @@ impl Patch {
         for p in pieces.iter_mut() {
             p.offset = [p.offset[0] - lo[0], p.offset[1] - lo[1]];
         }
-        let (width, height) = (hi[0] - lo[0], hi[1] - lo[1]);
+        Patch::from_pieces(pieces, hi[0] - lo[0], hi[1] - lo[1])
+    }
+
+    /// The patch covering the chart rectangle `rect` = `[s0, s1, t0, t1]` of a domain whose
+    /// faces (indices into [`Surface::faces`]) lie in one chart under `placements` (by mesh
+    /// face): the parts of the faces inside it as pieces. `None` if faces do not fill the
+    /// rectangle (a hole or the boundary cuts into it) or it has no area.
+    pub fn from_chart_rect(
+        surface: &Surface,
+        placements: &[crate::tmesh::walk::Placement],
+        rect: [f64; 4],
+    ) -> Option<Patch> {
+        let (width, height) = (rect[1] - rect[0], rect[3] - rect[2]);
+        if !(width > 0.0 && height > 0.0) {
+            return None;
+        }
+        let mut pieces = Vec::new();
+        let mut area = 0.0;
+        for (fi, f) in surface.faces().iter().enumerate() {
+            let pl = placements.get(f.mesh_face as usize)?;
+            let (k, off) = (pl.quarter_turns % 4, pl.offset);
+            let (a, b) = chart_rect(&[0.0, f.width, 0.0, f.height], (k, off));
+            let (lo, hi) = (
+                [a[0].max(rect[0]), a[1].max(rect[2])],
+                [b[0].min(rect[1]), b[1].min(rect[3])],
+            );
+            if !(hi[0] > lo[0] && hi[1] > lo[1]) {
+                continue;
+            }
+            area += (hi[0] - lo[0]) * (hi[1] - lo[1]);
+            let back = |c: [f64; 2]| rot((4 - k) % 4, [c[0] - off[0], c[1] - off[1]]);
+            let (x, y) = (back(lo), back(hi));
+            pieces.push(Piece {
+                face: fi as u32,
+                local: [
+                    x[0].min(y[0]).max(0.0),
+                    x[0].max(y[0]).min(f.width),
+                    x[1].min(y[1]).max(0.0),
+                    x[1].max(y[1]).min(f.height),
+                ],
+                quarter_turns: k,
+                offset: [off[0] - rect[0], off[1] - rect[2]],
+            });
+        }
+        let whole = width * height;
+        if pieces.is_empty() || (area - whole).abs() > RECT_FILL_REL * whole {
+            return None;
+        }
+        Some(Patch::from_pieces(pieces, width, height))
+    }
+
+    /// A patch of `width × height` knot units from pieces placed in its chart.
+    fn from_pieces(pieces: Vec<Piece>, width: f64, height: f64) -> Patch {
         let tol = KNOT_MATCH_REL * width.max(height);
         let mut s_breaks: Vec<f64> = Vec::new();
         let mut t_breaks: Vec<f64> = Vec::new();

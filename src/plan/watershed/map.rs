@@ -37,6 +37,10 @@ pub struct CurvatureMap {
     /// Where each grid point lies on the surface: the face (index into the surface's
     /// faces) and its `(u, v)`.
     pub at: Grid<Option<(u32, [f64; 2])>>,
+    /// Every mesh face's placement in the chart.
+    pub placements: Vec<Placement>,
+    /// Every surface face's rectangle in the chart, `[s0, s1, t0, t1]`.
+    pub face_rects: Vec<[f64; 4]>,
 }
 
 /// The curvature map of `model` with `per_unit` grid points per knot unit. Errors where
@@ -165,6 +169,8 @@ pub fn curvature_map(model: &Model, per_unit: f64) -> Result<CurvatureMap> {
         mean,
         valid,
         at,
+        face_rects: rects.iter().map(|r| r.2).collect(),
+        placements,
     })
 }
 
@@ -175,7 +181,7 @@ fn place(pl: &Placement, l: [f64; 2]) -> [f64; 2] {
 }
 
 /// Face-local knot coordinates of chart position `c` under placement `pl`.
-fn unplace(pl: &Placement, c: [f64; 2]) -> [f64; 2] {
+pub(crate) fn unplace(pl: &Placement, c: [f64; 2]) -> [f64; 2] {
     rotate(
         (4 - pl.quarter_turns % 4) % 4,
         [c[0] - pl.offset[0], c[1] - pl.offset[1]],

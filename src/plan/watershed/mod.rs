@@ -8,6 +8,7 @@
 
 pub mod boxes;
 pub mod map;
+pub mod rects;
 pub mod regions;
 
 /// Values on a uniform grid, `i` along the first parameter (`s`), `j` along the second
@@ -145,6 +146,62 @@ pub fn features(model: &Model, per_unit: f64) -> Result<Features> {
     })
 }
 
+/// Default fill tolerance of the feature boxes (the paper's experiments use 0.5).
+pub const DEFAULT_TOR: f64 = 0.5;
+
+impl Features {
+    /// Every feature region's boxes at fill tolerance `tor`, expanded by half a grid step
+    /// and clipped to the map: the region's label and the box in the chart.
+    pub fn boxes(&self, tor: f64) -> Vec<(u32, boxes::GridBox, [f64; 4])> {
+        let m = &self.map;
+        let lo = m.origin;
+        let hi = [
+            lo[0] + (m.valid.nx - 1) as f64 * m.step[0],
+            lo[1] + (m.valid.ny - 1) as f64 * m.step[1],
+        ];
+        let mut out = Vec::new();
+        for f in &self.features {
+            let label = f.region.label;
+            let region = Grid {
+                nx: self.labels.nx,
+                ny: self.labels.ny,
+                cells: self.labels.cells.iter().map(|&l| l == label).collect(),
+            };
+            for b in boxes::poly_bounding_boxes(&region, tor) {
+                let e = b.expanded(m.origin, m.step);
+                let clipped = [
+                    e[0].max(lo[0]),
+                    e[1].min(hi[0]),
+                    e[2].max(lo[1]),
+                    e[3].min(hi[1]),
+                ];
+                out.push((label, b, clipped));
+            }
+        }
+        out
+    }
+
+    /// The domain in rectangles: the feature boxes at `tor` and maximal rectangles of the
+    /// rest (see [`rects`]).
+    pub fn rectangles(&self, tor: f64) -> Vec<rects::ChartRect> {
+        let boxes: Vec<(u32, [f64; 4])> = self
+            .boxes(tor)
+            .into_iter()
+            .map(|(l, _, r)| (l, r))
+            .collect();
+        let size = self
+            .map
+            .face_rects
+            .iter()
+            .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
+            .fold(0.0f64, f64::max);
+        rects::rectangles(&self.map.face_rects, &boxes, LINE_MATCH_REL * size.max(1.0))
+    }
+}
+
+/// Lines of the rectangle cut closer than this share of the largest face are one.
+const LINE_MATCH_REL: f64 = 1e-9;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,6 +250,104 @@ mod tests {
                     assert_eq!(*l, regions::BACKGROUND);
                 }
             }
+        }
+    }
+
+    /// The rectangles partition the domain (their areas add up to the faces', none
+    /// overlaps), each is filled by faces (a patch can be made of it, so none reaches into
+    /// the hole), the surface through each patch is the surface at the same chart point,
+    /// and every feature box is covered by rectangles of its feature.
+    #[test]
+    fn rectangles_partition_the_domain_into_patches() {
+        for name in ["bumps", "bumps-hole"] {
+            let m = samples::load_sample(name).unwrap();
+            let f = features(&m, map::DEFAULT_PER_UNIT).unwrap();
+            let rects = f.rectangles(DEFAULT_TOR);
+            let area = |r: &[f64; 4]| (r[1] - r[0]) * (r[3] - r[2]);
+            let domain: f64 = f.map.face_rects.iter().map(area).sum();
+            let total: f64 = rects.iter().map(|r| area(&r.chart)).sum();
+            assert!(
+                (total - domain).abs() < 1e-9 * domain,
+                "{name}: {total} vs {domain}"
+            );
+            for (a, ra) in rects.iter().enumerate() {
+                for rb in &rects[a + 1..] {
+                    let (x, y) = (&ra.chart, &rb.chart);
+                    let w = x[1].min(y[1]) - x[0].max(y[0]);
+                    let h = x[3].min(y[3]) - x[2].max(y[2]);
+                    assert!(w <= 1e-9 || h <= 1e-9, "{name}: {x:?} overlaps {y:?}");
+                }
+            }
+            let boxes = f.boxes(DEFAULT_TOR);
+            for f_ in &f.features {
+                let label = f_.region.label;
+                let covered: f64 = rects
+                    .iter()
+                    .filter(|r| r.feature == Some(label))
+                    .map(|r| area(&r.chart))
+                    .sum();
+                let boxed: f64 = boxes
+                    .iter()
+                    .filter(|b| b.0 == label)
+                    .map(|b| area(&b.2))
+                    .sum();
+                // All of it where the boxes lie inside the domain (bumps); a box reaching
+                // into the hole loses that part.
+                assert!(covered <= boxed * (1.0 + 1e-9), "{name}: feature {label}");
+                if name == "bumps" {
+                    assert!(covered >= boxed * (1.0 - 1e-9), "{name}: feature {label}");
+                }
+            }
+            let featured = rects.iter().filter(|r| r.feature.is_some()).count();
+            assert!(
+                featured >= f.features.len(),
+                "{name}: {featured} feature rectangles"
+            );
+            for r in &rects {
+                let patch =
+                    crate::layout::Patch::from_chart_rect(&m.surface, &f.map.placements, r.chart)
+                        .unwrap_or_else(|| panic!("{name}: {:?} is not filled by faces", r.chart));
+                for (u, v) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.5), (0.5, 1.0)] {
+                    let c = [
+                        r.chart[0] + u * (r.chart[1] - r.chart[0]),
+                        r.chart[2] + v * (r.chart[3] - r.chart[2]),
+                    ];
+                    let p = patch.subs(&m.surface, u, v);
+                    // The face holding the chart point, evaluated directly.
+                    let q = m
+                        .surface
+                        .faces()
+                        .iter()
+                        .enumerate()
+                        .find_map(|(fi, face)| {
+                            let fr = f.map.face_rects[fi];
+                            let inside = c[0] >= fr[0] - 1e-12
+                                && c[0] <= fr[1] + 1e-12
+                                && c[1] >= fr[2] - 1e-12
+                                && c[1] <= fr[3] + 1e-12;
+                            inside.then(|| {
+                                let pl = f.map.placements[face.mesh_face as usize];
+                                let l = map::unplace(&pl, c);
+                                m.surface.subs(
+                                    fi,
+                                    (l[0] / face.width).clamp(0.0, 1.0),
+                                    (l[1] / face.height).clamp(0.0, 1.0),
+                                )
+                            })
+                        })
+                        .unwrap();
+                    assert!(
+                        (p - q).norm() < 1e-9 * m.surface.bbox().diagonal(),
+                        "{name}: {p} vs {q}"
+                    );
+                }
+            }
+            println!(
+                "{name}: {} features, {} boxes, {} rectangles ({featured} of features)",
+                f.features.len(),
+                boxes.len(),
+                rects.len()
+            );
         }
     }
 
