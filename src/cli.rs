@@ -13,7 +13,7 @@ const USAGE: &str = "usage:
   tspath sample --list
   tspath sample NAME -o FILE.json
   tspath export MODEL -o FILE.stl|FILE.obj [--chordal MM]
-  tspath plan MODEL [--strategy isoparametric|isfc] [--isfc-plain]
+  tspath plan MODEL [--strategy isoparametric|isfc|watershed|multi-rectangle] [--isfc-plain]
               [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--axis-preset vertical|gan2014]

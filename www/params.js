@@ -11,7 +11,7 @@
  */
 export const PARAMS = [
   // Strategy
-  { key: 'strategy', field: 'strategy', group: 'strategy', label: 'How the surface is cut', kind: 'choice', choices: [['isoparametric', 'Patch by patch (isoparametric)'], ['isfc', 'One continuous pass (space-filling curve)']], default: 'isoparametric' },
+  { key: 'strategy', field: 'strategy', group: 'strategy', label: 'How the surface is cut', kind: 'choice', choices: [['isoparametric', 'Patch by patch (isoparametric)'], ['isfc', 'One continuous pass (space-filling curve)'], ['watershed', 'Feature regions in rectangles (watershed)'], ['multi-rectangle', 'Rectangles, one direction (multi-rectangle)']], default: 'isoparametric' },
   { key: 'isfc-plain', field: 'isfc_plain', group: 'strategy', label: 'Plain curve: the paper\u2019s baseline, without the parity repair and the corner compensation', kind: 'flag', default: false, isfcOnly: true },
   { key: 'axis-preset', field: null, group: 'strategy', label: 'Tool axis preset', kind: 'choice', choices: [['', 'none: lead and tilt as set under Tool axis'], ['gan2014', 'Gan et al. 2014: 10\u00b0 lead from the surface normal']], default: '', fiveAxis: true },
   // Tool

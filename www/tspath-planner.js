@@ -151,6 +151,8 @@ const TEMPLATE = `
 const STRATEGY_NAMES = {
   isoparametric: 'patch by patch (isoparametric)',
   isfc: 'one continuous pass (space-filling curve)',
+  watershed: 'feature regions in rectangles (watershed)',
+  'multi-rectangle': 'rectangles, one direction (multi-rectangle)',
 };
 
 /** Statistics rows: id, label, value from (report, verification summary, context); the
@@ -1134,6 +1136,15 @@ export class TspathPlanner extends HTMLElement {
     const rows = STATS.map(([id, label, f]) => [id, label, f(r, v, ctx), rawStat(id, r, v)]);
     const time = rows.find((x) => x[0] === 'machining_time_min');
     time[1] = `Machining time at ${int(p.options.feed_mm_min ?? 1000)} mm/min`;
+    if (r.rectangles) {
+      // After the retractions: the regions and rectangles the surface was cut into.
+      const at = rows.findIndex((x) => x[0] === 'retractions') + 1;
+      const regions = r.regions || [];
+      const convex = regions.filter((x) => x.kind === 'convex').length;
+      rows.splice(at, 0,
+        ['regions', 'Feature regions', r.strategy === 'watershed' ? `${int(regions.length)} (${int(convex)} convex, ${int(regions.length - convex)} concave)` : 'none (baseline)', String(regions.length)],
+        ['rectangles', 'Rectangles', `${int(r.rectangles.length)}, ${int(r.rectangles.filter((x) => x.crossfeed === 'V').length)} cut along u`, String(r.rectangles.length)]);
+    }
     if (r.strategy === 'isfc' && r.grid) {
       // After the retractions: what the one pass is made of.
       const at = rows.findIndex((x) => x[0] === 'retractions') + 1;

@@ -436,6 +436,67 @@ impl PatchLayout {
         }
     }
 
+    /// A layout of the chart rectangles `rects` (`[s0, s1, t0, t1]`) of a domain laid flat
+    /// under `placements` (see [`Patch::from_chart_rect`]): one patch per rectangle, in
+    /// order, connected where rectangles share a stretch of side (boundary) or only a point
+    /// (corner). `None` if faces do not fill a rectangle.
+    pub fn from_chart_rects(
+        surface: &Surface,
+        placements: &[crate::tmesh::walk::Placement],
+        rects: &[[f64; 4]],
+    ) -> Option<PatchLayout> {
+        let patches = rects
+            .iter()
+            .map(|r| Patch::from_chart_rect(surface, placements, *r))
+            .collect::<Option<Vec<_>>>()?;
+        let size = rects
+            .iter()
+            .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
+            .fold(0.0f64, f64::max);
+        let tol = KNOT_MATCH_REL * size.max(1.0);
+        let mut connections = Vec::new();
+        for (a, ra) in rects.iter().enumerate() {
+            for (b, rb) in rects.iter().enumerate().skip(a + 1) {
+                // Overlap of the two along s and along t (negative: apart).
+                let ds = ra[1].min(rb[1]) - ra[0].max(rb[0]);
+                let dt = ra[3].min(rb[3]) - ra[2].max(rb[2]);
+                if ds < -tol || dt < -tol {
+                    continue;
+                }
+                // Which sides touch: 0 v = 0 (t0), 1 u = 1 (s1), 2 v = 1 (t1), 3 u = 0 (s0).
+                let near = |x: f64, y: f64| (x - y).abs() <= tol;
+                let sides = if near(ra[1], rb[0]) {
+                    Some((1, 3))
+                } else if near(ra[0], rb[1]) {
+                    Some((3, 1))
+                } else if near(ra[3], rb[2]) {
+                    Some((2, 0))
+                } else if near(ra[2], rb[3]) {
+                    Some((0, 2))
+                } else {
+                    None
+                };
+                let Some(sides) = sides else { continue };
+                let along = if sides.0 % 2 == 1 { dt } else { ds };
+                let (kind, sides) = if along > tol {
+                    (ConnectionKind::Boundary, Some(sides))
+                } else {
+                    (ConnectionKind::Corner, None)
+                };
+                connections.push(Connection {
+                    a: a as u32,
+                    b: b as u32,
+                    kind,
+                    sides,
+                });
+            }
+        }
+        Some(PatchLayout {
+            patches,
+            connections,
+        })
+    }
+
     /// Number of patches.
     pub fn len(&self) -> usize {
         self.patches.len()

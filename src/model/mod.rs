@@ -83,6 +83,20 @@ impl Model {
         })
     }
 
+    /// The same surface cut into the patches of `layout` (a strategy's own rectangles).
+    pub fn with_layout(&self, layout: PatchLayout) -> Model {
+        Model {
+            name: self.name.clone(),
+            format: self.format.clone(),
+            units_read: self.units_read.clone(),
+            mesh: self.mesh.clone(),
+            surface: self.surface.clone(),
+            layout,
+            concave: self.concave.clone(),
+            side: self.side.clone(),
+        }
+    }
+
     /// The side of the surface a tool machines: +1 where the normal `S_u × S_v` points to,
     /// −1 for the other. A closed surface is machined from outside (the side its normal
     /// points to when the enclosed volume comes out positive); an open one from the side

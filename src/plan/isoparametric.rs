@@ -566,7 +566,7 @@ pub fn patch_costs(model: &Model) -> CostMatrix {
 /// Arc length of a patch's iso-lines: the total path length of a zig-zag with crossfeed
 /// `c` is about the length of one pass times the number of passes, which goes with the
 /// length across; so the shorter path crosses the longer way.
-fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
+pub fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
     let len = |along_u: bool| -> f64 {
         let mut total = 0.0;
         for w in [0.25, 0.5, 0.75] {
@@ -620,6 +620,18 @@ pub fn draft(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Draft> {
+    draft_with(model, opts, progress, None, "isoparametric")
+}
+
+/// As [`draft`], with each patch's crossfeed given (`crossfeeds`, one per patch; the
+/// option's or the longer side's otherwise), the draft named `strategy`.
+pub fn draft_with(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+    crossfeeds: Option<&[Crossfeed]>,
+    strategy: &'static str,
+) -> Result<Draft> {
     opts.validate()?;
     let np = model.layout.len();
     if np == 0 {
@@ -658,10 +670,12 @@ pub fn draft(
         .collect();
     let preferred: Vec<Crossfeed> = views
         .iter()
-        .map(|v| match opts.crossfeed {
-            Some(c) => c,
-            None => preferred_crossfeed(v),
-        })
+        .map(
+            |v| match (crossfeeds.and_then(|c| c.get(v.index)), opts.crossfeed) {
+                (Some(&c), _) | (None, Some(c)) => c,
+                (None, None) => preferred_crossfeed(v),
+            },
+        )
         .collect();
     let start = opts.start_patch.unwrap_or(0) as usize;
     let finish = opts
@@ -790,7 +804,7 @@ pub fn draft(
             last_move: out.len() - 1,
         });
     }
-    Ok(out.finish("isoparametric", runs, worst, forced))
+    Ok(out.finish(strategy, runs, worst, forced))
 }
 
 /// Feed moves along the patch boundary from pass `w0` to pass `w1` at parameter `t`, split

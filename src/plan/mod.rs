@@ -36,6 +36,8 @@ pub fn plan(
     match opts.strategy {
         Strategy::Isoparametric => isoparametric::plan(model, opts, progress),
         Strategy::Isfc => isfc::plan(model, opts, progress),
+        Strategy::Watershed => watershed::plan(model, opts, progress, true),
+        Strategy::MultiRectangle => watershed::plan(model, opts, progress, false),
     }
 }
 pub use pipeline::Planned;

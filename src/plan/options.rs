@@ -79,17 +79,32 @@ pub enum Strategy {
     Isoparametric,
     /// Improved space-filling curve (Gan et al. 2014).
     Isfc,
+    /// Watershed feature regions and optimised multi-rectangles (Liu et al. 2020): a
+    /// rectangle per feature box and maximal rectangles of the rest, each cut along its
+    /// longer side.
+    Watershed,
+    /// The baseline of Liu et al.: the domain's maximal rectangles without feature regions,
+    /// all cut in one direction.
+    #[serde(rename = "multi-rectangle")]
+    MultiRectangle,
 }
 
 impl Strategy {
     /// Every strategy, in the order the CLI and the page list them.
-    pub const ALL: [Strategy; 2] = [Strategy::Isoparametric, Strategy::Isfc];
+    pub const ALL: [Strategy; 4] = [
+        Strategy::Isoparametric,
+        Strategy::Isfc,
+        Strategy::Watershed,
+        Strategy::MultiRectangle,
+    ];
 
     /// Its name in options, the CLI and the report.
     pub fn name(self) -> &'static str {
         match self {
             Strategy::Isoparametric => "isoparametric",
             Strategy::Isfc => "isfc",
+            Strategy::Watershed => "watershed",
+            Strategy::MultiRectangle => "multi-rectangle",
         }
     }
 

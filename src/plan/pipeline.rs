@@ -58,6 +58,11 @@ pub struct Planned {
     /// The space-filling curve's cells and tree as segments, for drawing (`isfc` only; the
     /// strategy sets it after the pipeline).
     pub isfc_layer: Option<super::isfc::layer::Layer>,
+    /// The patches the plan's patch numbers refer to, where the strategy cut the surface
+    /// into its own (the watershed rectangles); the model's layout otherwise.
+    pub layout: Option<crate::layout::PatchLayout>,
+    /// The watershed strategies' regions and rectangles.
+    pub watershed: Option<super::watershed::plan::WatershedStats>,
 }
 
 /// Plans with a strategy: `draft` makes its draft, reporting on the first `draft_share` of
@@ -181,6 +186,8 @@ pub fn finish(
     Ok(Planned {
         isfc: draft.isfc,
         isfc_layer: None,
+        layout: None,
+        watershed: None,
         strategy: draft.strategy,
         toolpath: path,
         forced_retractions: draft.forced_retractions,
@@ -221,8 +228,9 @@ impl Planned {
     /// The rest area as rectangles of the surface's faces, for the verification's mask.
     pub fn rest_rects(&self, model: &Model) -> Vec<RestRect> {
         let mut out = Vec::new();
+        let layout = self.layout.as_ref().unwrap_or(&model.layout);
         for (f, _) in &self.rest.footprints {
-            let patch = &model.layout.patches[f.patch as usize];
+            let patch = &layout.patches[f.patch as usize];
             for (face, rect) in patch.face_rects(&model.surface, f.rect) {
                 out.push(RestRect { face, rect });
             }
@@ -236,8 +244,9 @@ impl Planned {
     pub fn rest_triangles(&self, model: &Model) -> (Vec<f32>, Vec<u8>) {
         let mut pos = Vec::new();
         let mut why = Vec::new();
+        let layout = self.layout.as_ref().unwrap_or(&model.layout);
         for (f, w) in &self.rest.footprints {
-            let patch = &model.layout.patches[f.patch as usize];
+            let patch = &layout.patches[f.patch as usize];
             let [u0, u1, v0, v1] = f.rect;
             let cells = |d: f64| ((d / REST_CELL).ceil() as usize).clamp(1, REST_CELLS_MAX);
             let (nu, nv) = (cells(u1 - u0), cells(v1 - v0));
@@ -269,6 +278,41 @@ impl Planned {
         let mut r = self
             .toolpath
             .report(self.strategy, opts.feed_mm_min, opts.plunge_feed_mm_min);
+        if let Some(w) = &self.watershed {
+            r.regions =
+                Some(w.regions.clone()).filter(|v| !v.is_empty() || self.strategy == "watershed");
+            // Passes per rectangle, added up where the pipeline split a rectangle's run.
+            let mut rects: Vec<super::toolpath::RectangleReport> = w
+                .rectangle_regions
+                .iter()
+                .map(|&region| super::toolpath::RectangleReport {
+                    region,
+                    crossfeed: super::corners::Crossfeed::V,
+                    passes: 0,
+                })
+                .collect();
+            let mut seen = vec![false; rects.len()];
+            for run in &r.patch_order {
+                if let Some(x) = rects.get_mut(run.patch as usize) {
+                    if !seen[run.patch as usize] {
+                        x.crossfeed = run.crossfeed;
+                        x.passes = run.passes;
+                        seen[run.patch as usize] = true;
+                    }
+                }
+            }
+            r.notes.push(format!(
+                "{}: {} feature region(s) ({} convex, {} concave) on a {} × {} curvature map, {} rectangles",
+                self.strategy,
+                w.regions.len(),
+                w.regions.iter().filter(|x| x.kind == super::watershed::FeatureKind::Convex).count(),
+                w.regions.iter().filter(|x| x.kind == super::watershed::FeatureKind::Concave).count(),
+                w.map_points[0],
+                w.map_points[1],
+                rects.len()
+            ));
+            r.rectangles = Some(rects);
+        }
         if let Some(s) = &self.isfc {
             r.grid = Some(super::toolpath::GridSize {
                 s_lines: s.s_lines,

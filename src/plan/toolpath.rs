@@ -139,6 +139,23 @@ pub struct PlanReport {
     /// `isfc`: turns with a corner detour.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensated_corners: Option<usize>,
+    /// `watershed`: the feature regions (kind, area, boxes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub regions: Option<Vec<super::watershed::plan::RegionReport>>,
+    /// `watershed`, `multi-rectangle`: every rectangle (patch), its feature region, the
+    /// direction it is cut in and its passes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rectangles: Option<Vec<RectangleReport>>,
+}
+
+/// One rectangle of a watershed plan.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RectangleReport {
+    /// The feature region (index into `regions`), none for the rest of the domain.
+    pub region: Option<u32>,
+    /// `U`: passes `u = const`, cutting along `v`; `V`: cutting along `u`.
+    pub crossfeed: Crossfeed,
+    pub passes: usize,
 }
 
 /// Size of a space-filling curve's grid.
@@ -270,6 +287,8 @@ impl Toolpath {
             tree_links: None,
             repaired_cells: None,
             compensated_corners: None,
+            regions: None,
+            rectangles: None,
         };
         let mut patches: Vec<u32> = self.moves.iter().map(|m| m.patch).collect();
         patches.sort_unstable();

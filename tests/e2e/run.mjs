@@ -1071,6 +1071,33 @@ test('isfc with the gan2014 axis preset on a five-axis machine: the CLI\'s --axi
   return `${r.cl_points} CL points, largest axis step ${r.max_axis_step_deg.toFixed(2)}°; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
 });
 
+test('watershed: bumps-hole in feature rectangles; the report from wasm is the CLI\'s key by key, the program the CLI\'s', async (page, url) => {
+  const what = 'bumps-hole watershed';
+  await page.goto(`${url}?model=bumps-hole&strategy=watershed&tool-radius=1&scallop=0.05&${SIM}`);
+  await page.waitForSelector(`${HOST}[data-model="bumps-hole"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
+  const chosen = await page.$eval(HOST, (el) => el.shadowRoot.getElementById('p-strategy').selectedOptions[0].textContent);
+  check(chosen === 'Feature regions in rectangles (watershed)', `?strategy=watershed chooses it: “${chosen}”`);
+  await page.uncheck('#auto');
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  await waitVerified(page);
+  const cli = cliPlan('bumps-hole', { toolRadius: 1, scallop: 0.05, extra: ['--strategy', 'watershed'] });
+  const r = cli.report;
+  check(r.strategy === 'watershed' && r.regions.length === 2 && r.rectangles.length === r.patches, `${r.regions.length} regions, ${r.rectangles.length} rectangles`);
+  const mine = await host(page, (el) => el.plan.planReport);
+  const cmp = compareReports(mine, r, what);
+  // Key order aside (the CLI writes keys sorted), the same values.
+  const canon = (list) => JSON.stringify(list.map((o) => Object.keys(o).sort().map((k) => [k, o[k]])));
+  check(canon(mine.regions) === canon(r.regions) && canon(mine.rectangles) === canon(r.rectangles), `regions and rectangles as the CLI has them: ${canon(mine.regions)} vs ${canon(r.regions)}`);
+  const shown = (await page.textContent('#stats-regions')).trim();
+  check(/2 \(1 convex, 1 concave\)/.test(shown), `regions shown as “${shown}”`);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  check(g === cli.gcode, `the program is the CLI's --strategy watershed program (${g.length} vs ${cli.gcode.length} bytes)`);
+  await page.screenshot({ path: join(shots, 'watershed-bumps-hole.png') });
+  return `${r.regions.length} regions, ${r.rectangles.length} rectangles, ${r.reversals} reversals; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
+});
+
 test('a strategy that is not one is named, planning waits, and the page stays usable', async (page, url) => {
   await page.goto(`${url}?model=plate-hole&strategy=zigzag&tool-radius=1&scallop=0.05&${SIM}`);
   await waitState(page, 'model-loaded');
@@ -1084,7 +1111,7 @@ test('a strategy that is not one is named, planning waits, and the page stays us
   await setParam(page, 'strategy', 'isfc');
   check(await page.getAttribute('#p-strategy', 'aria-invalid') === 'false' && !(await page.isDisabled('#plan')), 'fixed by choosing');
   const offered = await page.$$eval('#p-strategy option', (o) => o.map((x) => x.value));
-  check(JSON.stringify(offered) === '["isoparametric","isfc"]', `the wrong value leaves the list: ${offered}`);
+  check(JSON.stringify(offered) === '["isoparametric","isfc","watershed","multi-rectangle"]', `the wrong value leaves the list: ${offered}`);
   await page.click('#plan');
   await waitPlans(page, 1);
   check(await attr(page, 'data-state') === 'planned' && (await stat(page, 'retractions')).value === 0, 'planned in one pass');

@@ -8,8 +8,11 @@
 
 pub mod boxes;
 pub mod map;
+pub mod plan;
 pub mod rects;
 pub mod regions;
+
+pub use plan::plan;
 
 /// Values on a uniform grid, `i` along the first parameter (`s`), `j` along the second
 /// (`t`), stored row by row (`j * nx + i`).
@@ -151,7 +154,9 @@ pub const DEFAULT_TOR: f64 = 0.5;
 
 impl Features {
     /// Every feature region's boxes at fill tolerance `tor`, expanded by half a grid step
-    /// and clipped to the map: the region's label and the box in the chart.
+    /// and clipped to the map: the region's label and the box in the chart. Boxes of one
+    /// region do not overlap; boxes of two regions may, and the rectangles then give the
+    /// overlap to the region found first (the higher curvature peak).
     pub fn boxes(&self, tor: f64) -> Vec<(u32, boxes::GridBox, [f64; 4])> {
         let m = &self.map;
         let lo = m.origin;
