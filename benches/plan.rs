@@ -69,6 +69,25 @@ fn bench_plan(c: &mut Criterion) {
             });
         }
     }
+    // The watershed strategy (issue 15): bumps-hole at r 1, h 0.01 mm (target 300 ms).
+    let m = samples::load_sample("bumps-hole").unwrap();
+    for strategy in [Strategy::Watershed, Strategy::MultiRectangle] {
+        let o = PlanOptions::default()
+            .with_tool_radius(1.0)
+            .with_scallop(0.01)
+            .with_strategy(strategy);
+        group.bench_function(format!("bumps-hole whole plan {}", strategy.name()), |b| {
+            b.iter(|| {
+                black_box(
+                    plan::plan(&m, &o, &mut |_| true)
+                        .unwrap()
+                        .toolpath
+                        .moves
+                        .len(),
+                )
+            })
+        });
+    }
     group.finish();
 }
 

@@ -65,6 +65,19 @@ for (const name of ['keycap-convex', 'keycap-concave']) {
   console.log(`plan mouse.tsm isfc (three-axis, r 1 mm, h 0.01 mm): ${report.cl_points} CL points, ${report.retractions} retractions, ${report.length_mm.toFixed(0)} mm in ${mouseMs.toFixed(0)} ms (target ≤ 1000 ms)`);
   mouse.free();
 }
+// The watershed strategy (issue 15): bumps-hole at r 1 mm, h 0.01 mm (target 800 ms), and
+// its multi-rectangle baseline.
+for (const strategy of ['watershed', 'multi-rectangle']) {
+  const m = wasm.Model.sample('bumps-hole');
+  let report = null;
+  const ms = best(() => {
+    const p = m.plan({ tool_radius_mm: 1, scallop_mm: 0.01, strategy }, null);
+    report = p.report();
+    p.free();
+  }, 3);
+  console.log(`plan bumps-hole ${strategy} (r 1 mm, h 0.01 mm): ${report.cl_points} CL points, ${report.rectangles.length} rectangles, ${report.reversals} reversals in ${ms.toFixed(0)} ms${strategy === 'watershed' ? ' (target ≤ 800 ms)' : ''}`);
+  m.free();
+}
 // The public .tsm files as a user opens them in the page: load, then plan three-axis.
 const models = fileURLToPath(new URL('../www/models/grapetec/', import.meta.url));
 for (const file of ['simple.tsm', 'mouse.tsm', 'face.tsm', 'fan.tsm', 'Bike.tsm', 'gearbox2-9.tsm']) {
