@@ -202,8 +202,9 @@ fn split_runs(runs: &[PatchRun], moves: &[Move], origin: &[u32]) -> Vec<PatchRun
 /// two lifted balls along a pass can be narrower than a quarter of the footprint: at 5 the
 /// search missed a 1.034 h cusp on face.tsm (r 0.5, h 0.01 mm); 9 holds the 5 × 5 points too.
 const TIGHT_SAMPLES: usize = 9;
-/// Halvings of the pattern search for the highest material left in a footprint.
-const TIGHT_SEARCH_HALVINGS: usize = 10;
+/// Halvings of the pattern search for the highest material left in a footprint: it starts
+/// at half the grid step and ends at 1/1024 of the footprint.
+const TIGHT_SEARCH_HALVINGS: usize = 9;
 /// Most grid peaks the pattern search starts from (peaks may be several).
 const TIGHT_SEARCH_STARTS: usize = 3;
 /// Grid peaks lower than this share of the scallop are not searched further: a peak of the
