@@ -149,3 +149,91 @@ fn a_domain_that_does_not_lie_flat_is_refused_with_the_reason() {
     assert!(r.regions.is_some_and(|x| !x.is_empty()));
     assert!(r.cl_points > 0);
 }
+
+/// Eq. 13–20: the T-mesh refined along every feature box side keeps its surface (1e-9 of
+/// the model's size on a 41 × 41 grid of the chart) and every box side then runs along
+/// face sides of the refined mesh (no face straddles it).
+#[test]
+fn refinement_along_the_boxes_keeps_the_surface_and_makes_box_sides_mesh_edges() {
+    use tspath::plan::watershed::{features, map, DEFAULT_TOR};
+    use tspath::surface::Surface;
+    let m = samples::load_sample("bumps").unwrap();
+    let f = features(&m, map::DEFAULT_PER_UNIT).unwrap();
+    let (refined, refused) = f.refined_mesh(&m, DEFAULT_TOR).unwrap();
+    assert!(refused.is_empty(), "refused {refused:?}");
+    assert!(refined.vertex_count() > m.mesh.vertex_count());
+    let surface = Surface::try_from_tmesh(&refined).unwrap();
+    let size = m.surface.bbox().diagonal();
+    let (lo, hi) = (
+        f.map.origin,
+        [
+            f.map.origin[0] + (f.map.valid.nx - 1) as f64 * f.map.step[0],
+            f.map.origin[1] + (f.map.valid.ny - 1) as f64 * f.map.step[1],
+        ],
+    );
+    let (mut worst, mut n) = (0.0f64, 0);
+    for i in 0..=40 {
+        for j in 0..=40 {
+            let s = lo[0] + (hi[0] - lo[0]) * (i as f64 + 0.5) / 41.0;
+            let t = lo[1] + (hi[1] - lo[1]) * (j as f64 + 0.5) / 41.0;
+            if let (Some(a), Some(b)) = (
+                support::chart_point(&m.mesh, &m.surface, s, t),
+                support::chart_point(&refined, &surface, s, t),
+            ) {
+                worst = worst.max((a - b).norm());
+                n += 1;
+            }
+        }
+    }
+    assert!(n > 1000);
+    assert!(worst <= 1e-9 * size, "surface moved {worst} mm");
+    // Face rectangles of the refined mesh in the chart.
+    let chart = refined.global_chart().unwrap();
+    let rects: Vec<[f64; 4]> = chart
+        .faces
+        .iter()
+        .map(|pl| {
+            let face = &refined.faces()[pl.face as usize];
+            let turn = |p: [f64; 2]| match pl.quarter_turns % 4 {
+                0 => p,
+                1 => [-p[1], p[0]],
+                2 => [-p[0], -p[1]],
+                _ => [p[1], -p[0]],
+            };
+            let (a, b) = (turn([0.0, 0.0]), turn([face.width, face.height]));
+            [
+                a[0].min(b[0]) + pl.offset[0],
+                a[0].max(b[0]) + pl.offset[0],
+                a[1].min(b[1]) + pl.offset[1],
+                a[1].max(b[1]) + pl.offset[1],
+            ]
+        })
+        .collect();
+    let eps = 1e-9;
+    let boxes = f.boxes(DEFAULT_TOR);
+    for (_, _, b) in &boxes {
+        for r in &rects {
+            let overlaps_t = r[2] < b[3] - eps && r[3] > b[2] + eps;
+            let overlaps_s = r[0] < b[1] - eps && r[1] > b[0] + eps;
+            for x in [b[0], b[1]] {
+                assert!(
+                    !(overlaps_t && r[0] < x - eps && r[1] > x + eps),
+                    "face {r:?} straddles s = {x}"
+                );
+            }
+            for y in [b[2], b[3]] {
+                assert!(
+                    !(overlaps_s && r[2] < y - eps && r[3] > y + eps),
+                    "face {r:?} straddles t = {y}"
+                );
+            }
+        }
+    }
+    println!(
+        "bumps: {} boxes, {} → {} control points, surface unchanged to {:.1e} of its size",
+        boxes.len(),
+        m.mesh.vertex_count(),
+        refined.vertex_count(),
+        worst / size
+    );
+}

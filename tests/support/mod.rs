@@ -164,3 +164,37 @@ pub fn tool_clearance(
     );
     shank.min(holder)
 }
+
+/// The surface point at global chart position `(s, t)`, found through the chart.
+pub fn chart_point(
+    mesh: &tspath::tmesh::TMesh,
+    surface: &tspath::surface::Surface,
+    s: f64,
+    t: f64,
+) -> Option<tspath::geom::Point3> {
+    let chart = mesh.global_chart()?;
+    let index: std::collections::HashMap<u32, usize> = surface
+        .faces()
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (f.mesh_face, i))
+        .collect();
+    for pl in &chart.faces {
+        let f = &mesh.faces()[pl.face as usize];
+        let Some(&fi) = index.get(&pl.face) else {
+            continue;
+        };
+        // Inverse placement: local = rot(-k)(chart - offset).
+        let (x, y) = (s - pl.offset[0], t - pl.offset[1]);
+        let (lx, ly) = match pl.quarter_turns % 4 {
+            0 => (x, y),
+            1 => (y, -x),
+            2 => (-x, -y),
+            _ => (-y, x),
+        };
+        if lx >= 0.0 && lx <= f.width && ly >= 0.0 && ly <= f.height {
+            return Some(surface.subs(fi, lx / f.width, ly / f.height));
+        }
+    }
+    None
+}

@@ -204,6 +204,61 @@ impl Features {
     }
 }
 
+impl Features {
+    /// The model's T-mesh refined so that every feature box edge at `tor` is a T-mesh
+    /// edge (eq. 13–20): a knot line along each box side, inserted across the whole domain
+    /// (the refinement this project has adds whole lines; a local one would stop at the
+    /// box), the surface unchanged. Returns the refined mesh and the lines refused because
+    /// they would need further knots (left out, never approximated). Errors on a model
+    /// that is not a T-spline laid flat in one chart.
+    pub fn refined_mesh(
+        &self,
+        model: &Model,
+        tor: f64,
+    ) -> Result<(crate::tmesh::TMesh, Vec<crate::tmesh::refine::KnotLine>)> {
+        use crate::tmesh::refine::KnotLine;
+        let mut lines: Vec<KnotLine> = Vec::new();
+        let size = self
+            .map
+            .face_rects
+            .iter()
+            .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
+            .fold(0.0f64, f64::max);
+        let tol = LINE_MATCH_REL * size.max(1.0);
+        let mut add = |l: KnotLine| {
+            let same = |a: &KnotLine| match (a, &l) {
+                (KnotLine::S(x), KnotLine::S(y)) | (KnotLine::T(x), KnotLine::T(y)) => {
+                    (x - y).abs() <= tol
+                }
+                _ => false,
+            };
+            if !lines.iter().any(same) {
+                lines.push(l);
+            }
+        };
+        for (_, _, b) in self.boxes(tor) {
+            add(KnotLine::S(b[0]));
+            add(KnotLine::S(b[1]));
+            add(KnotLine::T(b[2]));
+            add(KnotLine::T(b[3]));
+        }
+        if model.mesh.scheme() != crate::tmesh::Scheme::TSpline {
+            return Err(crate::error::Error::Unsupported(
+                "exact refinement along the feature boxes works on T-spline meshes; this model is a subdivision cage (its rectangles are planned without it)".into(),
+            ));
+        }
+        let mut mesh = model.mesh.clone();
+        let mut refused = Vec::new();
+        for line in lines {
+            match mesh.insert_knot_line(line) {
+                Ok(m) => mesh = m,
+                Err(_) => refused.push(line),
+            }
+        }
+        Ok((mesh, refused))
+    }
+}
+
 /// Lines of the rectangle cut closer than this share of the largest face are one.
 const LINE_MATCH_REL: f64 = 1e-9;
 
