@@ -28,53 +28,43 @@ for (const name of ['keycap-convex', 'tjunction']) {
   m.free();
 }
 
-// Planning at the paper's settings, and the wasm memory it needed.
-for (const name of ['keycap-convex', 'keycap-concave']) {
-  const m = wasm.Model.sample(name);
-  const opts = { tool_radius_mm: 0.5, scallop_mm: 0.005, chordal_mm: 0.001 };
-  let points = 0;
+// Best time of `runs` whole plans of model `m` with `opts`, and the last plan's report.
+function timePlan(m, opts, runs) {
+  let report = null;
   const ms = best(() => {
     const p = m.plan(opts, null);
-    points = p.report().cl_points;
+    report = p.report();
     p.free();
-  }, 5);
-  console.log(`plan ${name}: ${points} CL points in ${ms.toFixed(1)} ms`);
+  }, runs);
+  return { ms, report };
+}
+
+// Planning at the paper's settings, and the wasm memory it needed.
+const paper = { tool_radius_mm: 0.5, scallop_mm: 0.005, chordal_mm: 0.001 };
+for (const name of ['keycap-convex', 'keycap-concave']) {
+  const m = wasm.Model.sample(name);
+  const { ms, report } = timePlan(m, paper, 5);
+  console.log(`plan ${name}: ${report.cl_points} CL points in ${ms.toFixed(1)} ms`);
   m.free();
 }
 // The space-filling curve (issue 14): the convex keycap at the paper's settings (target
 // 400 ms) and mouse.tsm at r 1 mm, h 0.01 mm, three-axis (target 1 s), whole plans.
 {
   const m = wasm.Model.sample('keycap-convex');
-  const opts = { tool_radius_mm: 0.5, scallop_mm: 0.005, chordal_mm: 0.001, strategy: 'isfc' };
-  let points = 0;
-  const ms = best(() => {
-    const p = m.plan(opts, null);
-    points = p.report().cl_points;
-    p.free();
-  }, 5);
-  console.log(`plan keycap-convex isfc: ${points} CL points in ${ms.toFixed(1)} ms (target ≤ 400 ms)`);
+  const { ms, report } = timePlan(m, { ...paper, strategy: 'isfc' }, 5);
+  console.log(`plan keycap-convex isfc: ${report.cl_points} CL points in ${ms.toFixed(1)} ms (target ≤ 400 ms)`);
   m.free();
   const bytes = readFileSync(fileURLToPath(new URL('../www/models/grapetec/mouse.tsm', import.meta.url)));
   const mouse = wasm.Model.fromBytes(bytes, 'mouse.tsm');
-  let report = null;
-  const mouseMs = best(() => {
-    const p = mouse.plan({ tool_radius_mm: 1, scallop_mm: 0.01, max_tilt_deg: 0, strategy: 'isfc' }, null);
-    report = p.report();
-    p.free();
-  }, 3);
-  console.log(`plan mouse.tsm isfc (three-axis, r 1 mm, h 0.01 mm): ${report.cl_points} CL points, ${report.retractions} retractions, ${report.length_mm.toFixed(0)} mm in ${mouseMs.toFixed(0)} ms (target ≤ 1000 ms)`);
+  const t = timePlan(mouse, { tool_radius_mm: 1, scallop_mm: 0.01, max_tilt_deg: 0, strategy: 'isfc' }, 3);
+  console.log(`plan mouse.tsm isfc (three-axis, r 1 mm, h 0.01 mm): ${t.report.cl_points} CL points, ${t.report.retractions} retractions, ${t.report.length_mm.toFixed(0)} mm in ${t.ms.toFixed(0)} ms (target ≤ 1000 ms)`);
   mouse.free();
 }
 // The watershed strategy (issue 15): bumps-hole at r 1 mm, h 0.01 mm (target 800 ms), and
 // its multi-rectangle baseline.
 for (const strategy of ['watershed', 'multi-rectangle']) {
   const m = wasm.Model.sample('bumps-hole');
-  let report = null;
-  const ms = best(() => {
-    const p = m.plan({ tool_radius_mm: 1, scallop_mm: 0.01, strategy }, null);
-    report = p.report();
-    p.free();
-  }, 3);
+  const { ms, report } = timePlan(m, { tool_radius_mm: 1, scallop_mm: 0.01, strategy }, 3);
   console.log(`plan bumps-hole ${strategy} (r 1 mm, h 0.01 mm): ${report.cl_points} CL points, ${report.rectangles.length} rectangles, ${report.reversals} reversals in ${ms.toFixed(0)} ms${strategy === 'watershed' ? ' (target ≤ 800 ms)' : ''}`);
   m.free();
 }

@@ -187,28 +187,8 @@ fn refinement_along_the_boxes_keeps_the_surface_and_makes_box_sides_mesh_edges()
     }
     assert!(n > 1000);
     assert!(worst <= 1e-9 * size, "surface moved {worst} mm");
-    // Face rectangles of the refined mesh in the chart.
-    let chart = refined.global_chart().unwrap();
-    let rects: Vec<[f64; 4]> = chart
-        .faces
-        .iter()
-        .map(|pl| {
-            let face = &refined.faces()[pl.face as usize];
-            let turn = |p: [f64; 2]| match pl.quarter_turns % 4 {
-                0 => p,
-                1 => [-p[1], p[0]],
-                2 => [-p[0], -p[1]],
-                _ => [p[1], -p[0]],
-            };
-            let (a, b) = (turn([0.0, 0.0]), turn([face.width, face.height]));
-            [
-                a[0].min(b[0]) + pl.offset[0],
-                a[0].max(b[0]) + pl.offset[0],
-                a[1].min(b[1]) + pl.offset[1],
-                a[1].max(b[1]) + pl.offset[1],
-            ]
-        })
-        .collect();
+    // Face rectangles of the refined mesh in the chart (face 0 placed as before).
+    let rects = map::chart(&refined, &surface).unwrap().face_rects;
     let eps = 1e-9;
     let boxes = f.boxes(DEFAULT_TOR);
     for (_, _, b) in &boxes {

@@ -49,6 +49,7 @@
 
 use crate::error::{Error, Result};
 use crate::geom::Point3;
+use crate::tmesh::walk::rot;
 use crate::tmesh::{ControlPoint, FaceLoop, Scheme, TMesh, KNOT_MATCH_REL};
 use std::collections::{HashMap, VecDeque};
 
@@ -1531,16 +1532,6 @@ pub fn read(bytes: &[u8]) -> Result<(TMesh, TsmMeta)> {
 
 // ---------------------------------------------------------------------------------------
 // Global parameters.
-
-/// Rotation by `k` quarter turns counter-clockwise.
-fn rot(k: u8, p: [f64; 2]) -> [f64; 2] {
-    match k % 4 {
-        0 => p,
-        1 => [-p[1], p[0]],
-        2 => [-p[0], -p[1]],
-        _ => [p[1], -p[0]],
-    }
-}
 
 /// Position of half-edge `h`'s origin in its face's local frame `[0,W]×[0,H]`.
 fn local_origin(mesh: &TMesh, h: u32) -> [f64; 2] {

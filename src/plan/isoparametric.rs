@@ -73,6 +73,22 @@ pub struct PatchView<'a> {
     pub side: f64,
 }
 
+/// The patch views of `model`, seen from the side the tool works from.
+pub fn patch_views(model: &Model) -> Vec<PatchView<'_>> {
+    model
+        .layout
+        .patches
+        .iter()
+        .enumerate()
+        .map(|(index, patch)| PatchView {
+            index,
+            patch,
+            surface: &model.surface,
+            side: model.tool_side(),
+        })
+        .collect()
+}
+
 impl PatchView<'_> {
     /// Point and tool-side unit normal at `(u, v)`, from one evaluation.
     pub fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
@@ -656,18 +672,7 @@ pub fn draft_with(
         }
     }
     let r = opts.tool_radius_mm;
-    let views: Vec<PatchView> = model
-        .layout
-        .patches
-        .iter()
-        .enumerate()
-        .map(|(index, patch)| PatchView {
-            index,
-            patch,
-            surface: &model.surface,
-            side: model.tool_side(),
-        })
-        .collect();
+    let views = patch_views(model);
     let preferred: Vec<Crossfeed> = views
         .iter()
         .map(

@@ -279,9 +279,9 @@ impl Planned {
             .toolpath
             .report(self.strategy, opts.feed_mm_min, opts.plunge_feed_mm_min);
         if let Some(w) = &self.watershed {
-            r.regions =
-                Some(w.regions.clone()).filter(|v| !v.is_empty() || self.strategy == "watershed");
-            // Passes per rectangle, added up where the pipeline split a rectangle's run.
+            r.regions = w.regions.clone();
+            // Each rectangle's direction and passes: its first run (the pipeline splits a
+            // run where it leaves cut points out).
             let mut rects: Vec<super::toolpath::RectangleReport> = w
                 .rectangle_regions
                 .iter()
@@ -291,24 +291,28 @@ impl Planned {
                     passes: 0,
                 })
                 .collect();
-            let mut seen = vec![false; rects.len()];
-            for run in &r.patch_order {
+            for run in r.patch_order.iter().rev() {
                 if let Some(x) = rects.get_mut(run.patch as usize) {
-                    if !seen[run.patch as usize] {
-                        x.crossfeed = run.crossfeed;
-                        x.passes = run.passes;
-                        seen[run.patch as usize] = true;
-                    }
+                    (x.crossfeed, x.passes) = (run.crossfeed, run.passes);
                 }
             }
+            let regions = match (&w.regions, w.map_points) {
+                (Some(regions), Some([nx, ny])) => {
+                    let convex = regions
+                        .iter()
+                        .filter(|x| x.kind == super::watershed::FeatureKind::Convex)
+                        .count();
+                    format!(
+                        "{} feature region(s) ({convex} convex, {} concave) on a {nx} × {ny} curvature map, ",
+                        regions.len(),
+                        regions.len() - convex
+                    )
+                }
+                _ => String::new(),
+            };
             r.notes.push(format!(
-                "{}: {} feature region(s) ({} convex, {} concave) on a {} × {} curvature map, {} rectangles",
+                "{}: {regions}{} rectangles",
                 self.strategy,
-                w.regions.len(),
-                w.regions.iter().filter(|x| x.kind == super::watershed::FeatureKind::Convex).count(),
-                w.regions.iter().filter(|x| x.kind == super::watershed::FeatureKind::Concave).count(),
-                w.map_points[0],
-                w.map_points[1],
                 rects.len()
             ));
             r.rectangles = Some(rects);

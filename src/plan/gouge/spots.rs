@@ -20,9 +20,6 @@ const SPACING_SHARE: f64 = 0.5;
 /// sampled every 22°) and at most (bounds the cost for a tiny ball on a large model).
 const MIN_SAMPLES: usize = 4;
 const MAX_SAMPLES: usize = 128;
-/// Relative margin on the tool radius below which a concave radius counts as tight, as
-/// [`super::needed`] uses it: the curvature peaks between samples.
-const TIGHT_MARGIN: f64 = super::TIGHT_MARGIN;
 /// Distance within which two cells' side points are the same point, as a share of the
 /// gouge tolerance.
 const SAME_POINT_SHARE: f64 = 0.01;
@@ -42,7 +39,8 @@ impl Spots {
             marked: HashSet::new(),
         };
         let side = model.tool_side();
-        let tight = 1.0 / (r * (1.0 + TIGHT_MARGIN));
+        // The margin [`super::needed`] uses: the curvature peaks between samples.
+        let tight = 1.0 / (r * (1.0 + super::TIGHT_MARGIN));
         // A concave crease whose normals differ by `a` lets a ball touching one side cut
         // the other by up to r (1 − cos a).
         let crease_cos = 1.0 - 0.5 * tol / r;

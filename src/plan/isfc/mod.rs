@@ -29,7 +29,7 @@ pub mod tree;
 
 use self::cells::{Cell, Link, PatchGrid, Vertex, Weights};
 use super::draft::{Draft, DraftBuilder, Footprint, SurfacePoint};
-use super::isoparametric::{predicted, ParamSurface, PatchView};
+use super::isoparametric::{patch_views, predicted, ParamSurface, PatchView};
 use super::pipeline::Planned;
 use super::stepover::FeedDir;
 use super::PlanOptions;
@@ -241,22 +241,6 @@ pub fn curve(
         loops,
         predicted_mm: worst,
     })
-}
-
-/// The patch views of `model`, seen from the side the tool works from.
-fn patch_views(model: &Model) -> Vec<PatchView<'_>> {
-    model
-        .layout
-        .patches
-        .iter()
-        .enumerate()
-        .map(|(index, patch)| PatchView {
-            index,
-            patch,
-            surface: &model.surface,
-            side: model.tool_side(),
-        })
-        .collect()
 }
 
 /// The curve as a draft for the pipeline.

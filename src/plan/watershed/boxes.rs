@@ -50,57 +50,33 @@ impl GridBox {
 /// overlap (a box stops growing before it would take in a point of another piece of the
 /// region or meet a box already made).
 pub fn poly_bounding_boxes(region: &Grid<bool>, tor: f64) -> Vec<GridBox> {
-    let labels = Grid {
-        nx: region.nx,
-        ny: region.ny,
-        cells: region.cells.iter().map(|&x| u32::from(x)).collect(),
-    };
-    labelled_boxes(&labels, tor)
-        .into_iter()
-        .map(|(_, b)| b)
-        .collect()
-}
-
-/// [`poly_bounding_boxes`] for every region of a label grid (labels from 1; 0 is no
-/// region), region 1 first: no box overlaps another of any region or holds a point of
-/// another region. Each box comes with its region's label.
-pub fn labelled_boxes(labels: &Grid<u32>, tor: f64) -> Vec<(u32, GridBox)> {
-    let mut boxes: Vec<(u32, GridBox)> = Vec::new();
-    // Labelled points not yet in a box.
-    let mut left = Grid {
-        nx: labels.nx,
-        ny: labels.ny,
-        cells: labels.cells.iter().map(|&l| l != 0).collect(),
-    };
-    let top = labels.cells.iter().copied().max().unwrap_or(0);
-    for label in 1..=top {
-        let mut areas: Vec<Vec<(usize, usize)>> =
-            components(labels, |i, j| labels.at(i, j) == label);
-        // Work on the first found first; components are listed in grid order.
-        areas.reverse();
-        while let Some(area) = areas.pop() {
-            let mut inside = Grid::filled(labels.nx, labels.ny, false);
-            for &(i, j) in &area {
-                inside.set(i, j, true);
-            }
-            let clear = |b: &GridBox| {
-                boxes.iter().all(|(_, o)| !overlaps(o, b))
-                    && (b.j0..=b.j1)
-                        .all(|j| (b.i0..=b.i1).all(|i| !left.at(i, j) || inside.at(i, j)))
-            };
-            let b = grow_box(&inside, &area, tor, &clear);
-            for &(i, j) in &area {
-                if b.contains(i, j) {
-                    inside.set(i, j, false);
-                    left.set(i, j, false);
-                }
-            }
-            let mut rest = components(&inside, |i, j| inside.at(i, j));
-            rest.reverse();
-            // The pieces left are boxed before anything found later.
-            areas.extend(rest);
-            boxes.push((label, b));
+    let mut boxes: Vec<GridBox> = Vec::new();
+    // Region points not yet in a box.
+    let mut left = region.clone();
+    let mut areas: Vec<Vec<(usize, usize)>> = components(region);
+    // Work on the first found first; components are listed in grid order.
+    areas.reverse();
+    while let Some(area) = areas.pop() {
+        let mut inside = Grid::filled(region.nx, region.ny, false);
+        for &(i, j) in &area {
+            inside.set(i, j, true);
         }
+        let clear = |b: &GridBox| {
+            boxes.iter().all(|o| !overlaps(o, b))
+                && (b.j0..=b.j1).all(|j| (b.i0..=b.i1).all(|i| !left.at(i, j) || inside.at(i, j)))
+        };
+        let b = grow_box(&inside, &area, tor, &clear);
+        for &(i, j) in &area {
+            if b.contains(i, j) {
+                inside.set(i, j, false);
+                left.set(i, j, false);
+            }
+        }
+        let mut rest = components(&inside);
+        rest.reverse();
+        // The pieces left are boxed before anything found later.
+        areas.extend(rest);
+        boxes.push(b);
     }
     boxes
 }
@@ -195,17 +171,14 @@ fn grow_box(
     kept
 }
 
-/// The 4-connected components of the points where `on` holds, each in grid order, listed in
+/// The 4-connected components of the `true` points of `grid`, each in grid order, listed in
 /// the order of their first point.
-fn components<T: Copy>(
-    grid: &Grid<T>,
-    on: impl Fn(usize, usize) -> bool,
-) -> Vec<Vec<(usize, usize)>> {
+fn components(grid: &Grid<bool>) -> Vec<Vec<(usize, usize)>> {
     let mut seen = Grid::filled(grid.nx, grid.ny, false);
     let mut out = Vec::new();
     for j in 0..grid.ny {
         for i in 0..grid.nx {
-            if seen.at(i, j) || !on(i, j) {
+            if seen.at(i, j) || !grid.at(i, j) {
                 continue;
             }
             let mut comp = Vec::new();
@@ -214,7 +187,7 @@ fn components<T: Copy>(
             while let Some((x, y)) = stack.pop() {
                 comp.push((x, y));
                 for (nx, ny) in grid.neighbours(x, y) {
-                    if !seen.at(nx, ny) && on(nx, ny) {
+                    if !seen.at(nx, ny) && grid.at(nx, ny) {
                         seen.set(nx, ny, true);
                         stack.push((nx, ny));
                     }

@@ -159,11 +159,7 @@ impl Features {
     /// overlap to the region found first (the higher curvature peak).
     pub fn boxes(&self, tor: f64) -> Vec<(u32, boxes::GridBox, [f64; 4])> {
         let m = &self.map;
-        let lo = m.origin;
-        let hi = [
-            lo[0] + (m.valid.nx - 1) as f64 * m.step[0],
-            lo[1] + (m.valid.ny - 1) as f64 * m.step[1],
-        ];
+        let (lo, hi) = (m.chart.lo, m.chart.hi);
         let mut out = Vec::new();
         for f in &self.features {
             let label = f.region.label;
@@ -186,25 +182,14 @@ impl Features {
         out
     }
 
-    /// The domain in rectangles: the feature boxes at `tor` and maximal rectangles of the
-    /// rest (see [`rects`]).
-    pub fn rectangles(&self, tor: f64) -> Vec<rects::ChartRect> {
-        let boxes: Vec<(u32, [f64; 4])> = self
-            .boxes(tor)
-            .into_iter()
-            .map(|(l, _, r)| (l, r))
-            .collect();
-        let size = self
-            .map
-            .face_rects
-            .iter()
-            .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
-            .fold(0.0f64, f64::max);
-        rects::rectangles(&self.map.face_rects, &boxes, LINE_MATCH_REL * size.max(1.0))
+    /// The domain in rectangles: the feature `boxes` (from [`Features::boxes`]) and maximal
+    /// rectangles of the rest (see [`rects`]).
+    pub fn rectangles(&self, boxes: &[(u32, boxes::GridBox, [f64; 4])]) -> Vec<rects::ChartRect> {
+        let boxes: Vec<(u32, [f64; 4])> = boxes.iter().map(|&(l, _, r)| (l, r)).collect();
+        let chart = &self.map.chart;
+        rects::rectangles(&chart.face_rects, &boxes, chart.line_tol())
     }
-}
 
-impl Features {
     /// The model's T-mesh refined so that every feature box edge at `tor` is a T-mesh
     /// edge (eq. 13–20): a knot line along each box side, inserted across the whole domain
     /// (the refinement this project has adds whole lines; a local one would stop at the
@@ -218,13 +203,7 @@ impl Features {
     ) -> Result<(crate::tmesh::TMesh, Vec<crate::tmesh::refine::KnotLine>)> {
         use crate::tmesh::refine::KnotLine;
         let mut lines: Vec<KnotLine> = Vec::new();
-        let size = self
-            .map
-            .face_rects
-            .iter()
-            .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
-            .fold(0.0f64, f64::max);
-        let tol = LINE_MATCH_REL * size.max(1.0);
+        let tol = self.map.chart.line_tol();
         let mut add = |l: KnotLine| {
             let same = |a: &KnotLine| match (a, &l) {
                 (KnotLine::S(x), KnotLine::S(y)) | (KnotLine::T(x), KnotLine::T(y)) => {
@@ -258,9 +237,6 @@ impl Features {
         Ok((mesh, refused))
     }
 }
-
-/// Lines of the rectangle cut closer than this share of the largest face are one.
-const LINE_MATCH_REL: f64 = 1e-9;
 
 #[cfg(test)]
 mod tests {
@@ -322,9 +298,10 @@ mod tests {
         for name in ["bumps", "bumps-hole"] {
             let m = samples::load_sample(name).unwrap();
             let f = features(&m, map::DEFAULT_PER_UNIT).unwrap();
-            let rects = f.rectangles(DEFAULT_TOR);
+            let boxes = f.boxes(DEFAULT_TOR);
+            let rects = f.rectangles(&boxes);
             let area = |r: &[f64; 4]| (r[1] - r[0]) * (r[3] - r[2]);
-            let domain: f64 = f.map.face_rects.iter().map(area).sum();
+            let domain: f64 = f.map.chart.face_rects.iter().map(area).sum();
             let total: f64 = rects.iter().map(|r| area(&r.chart)).sum();
             assert!(
                 (total - domain).abs() < 1e-9 * domain,
@@ -338,7 +315,6 @@ mod tests {
                     assert!(w <= 1e-9 || h <= 1e-9, "{name}: {x:?} overlaps {y:?}");
                 }
             }
-            let boxes = f.boxes(DEFAULT_TOR);
             for f_ in &f.features {
                 let label = f_.region.label;
                 let covered: f64 = rects
@@ -364,9 +340,12 @@ mod tests {
                 "{name}: {featured} feature rectangles"
             );
             for r in &rects {
-                let patch =
-                    crate::layout::Patch::from_chart_rect(&m.surface, &f.map.placements, r.chart)
-                        .unwrap_or_else(|| panic!("{name}: {:?} is not filled by faces", r.chart));
+                let patch = crate::layout::Patch::from_chart_rect(
+                    &m.surface,
+                    &f.map.chart.placements,
+                    r.chart,
+                )
+                .unwrap_or_else(|| panic!("{name}: {:?} is not filled by faces", r.chart));
                 for (u, v) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.5), (0.5, 1.0)] {
                     let c = [
                         r.chart[0] + u * (r.chart[1] - r.chart[0]),
@@ -380,13 +359,13 @@ mod tests {
                         .iter()
                         .enumerate()
                         .find_map(|(fi, face)| {
-                            let fr = f.map.face_rects[fi];
+                            let fr = f.map.chart.face_rects[fi];
                             let inside = c[0] >= fr[0] - 1e-12
                                 && c[0] <= fr[1] + 1e-12
                                 && c[1] >= fr[2] - 1e-12
                                 && c[1] <= fr[3] + 1e-12;
                             inside.then(|| {
-                                let pl = f.map.placements[face.mesh_face as usize];
+                                let pl = f.map.chart.placements[face.mesh_face as usize];
                                 let l = map::unplace(&pl, c);
                                 m.surface.subs(
                                     fi,

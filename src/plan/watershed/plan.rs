@@ -11,7 +11,7 @@ use crate::layout::PatchLayout;
 use crate::model::Model;
 use crate::plan::corners::Crossfeed;
 use crate::plan::draft::Footprint;
-use crate::plan::isoparametric::{self, PatchView};
+use crate::plan::isoparametric;
 use crate::plan::pipeline::{self, Planned};
 use crate::plan::PlanOptions;
 use serde::{Deserialize, Serialize};
@@ -29,12 +29,12 @@ pub struct RegionReport {
 /// What the watershed strategies found and made.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WatershedStats {
-    /// Feature regions (none for the multi-rectangle baseline).
-    pub regions: Vec<RegionReport>,
+    /// Feature regions, and the grid points of the curvature map they were found on (none
+    /// for the multi-rectangle baseline, which has no map).
+    pub regions: Option<Vec<RegionReport>>,
+    pub map_points: Option<[usize; 2]>,
     /// Per rectangle (patch), the feature region it belongs to (index into `regions`).
     pub rectangle_regions: Vec<Option<u32>>,
-    /// Grid points of the curvature map.
-    pub map_points: [usize; 2],
 }
 
 /// Share of the progress bar the draft takes (the pipeline takes the rest).
@@ -51,49 +51,46 @@ pub fn plan(
     with_features: bool,
 ) -> Result<Planned> {
     opts.validate()?;
-    let found = features(model, map::DEFAULT_PER_UNIT)?;
-    let rects: Vec<rects::ChartRect> = if with_features {
-        found.rectangles(DEFAULT_TOR)
-    } else {
-        let size = found
-            .map
-            .face_rects
+    // The feature boxes and rectangles, or for the baseline the domain's rectangles alone.
+    let (chart, rects, regions, map_points) = if with_features {
+        let found = features(model, map::DEFAULT_PER_UNIT)?;
+        let boxes = found.boxes(DEFAULT_TOR);
+        let rects = found.rectangles(&boxes);
+        let regions: Vec<RegionReport> = found
+            .features
             .iter()
-            .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
-            .fold(0.0f64, f64::max);
-        rects::rectangles(&found.map.face_rects, &[], 1e-9 * size.max(1.0))
+            .map(|f| RegionReport {
+                kind: f.kind,
+                area_mm2: 0.0,
+                boxes: boxes.iter().filter(|b| b.0 == f.region.label).count(),
+            })
+            .collect();
+        let points = [found.map.valid.nx, found.map.valid.ny];
+        (found.map.chart, rects, Some(regions), Some(points))
+    } else {
+        let chart = map::chart(&model.mesh, &model.surface)?;
+        let rects = rects::rectangles(&chart.face_rects, &[], chart.line_tol());
+        (chart, rects, None, None)
     };
-    let chart: Vec<[f64; 4]> = rects.iter().map(|r| r.chart).collect();
-    let layout = PatchLayout::from_chart_rects(&model.surface, &found.map.placements, &chart)
+    let rect_charts: Vec<[f64; 4]> = rects.iter().map(|r| r.chart).collect();
+    let layout = PatchLayout::from_chart_rects(&model.surface, &chart.placements, &rect_charts)
         .ok_or_else(|| Error::Degenerate {
             location: "the domain's rectangles".into(),
             message: "a rectangle of the domain is not filled by faces".into(),
         })?;
     let cut = model.with_layout(layout);
-    let views: Vec<PatchView> = cut
-        .layout
-        .patches
-        .iter()
-        .enumerate()
-        .map(|(index, patch)| PatchView {
-            index,
-            patch,
-            surface: &cut.surface,
-            side: cut.tool_side(),
-        })
-        .collect();
     // Along the longer side per rectangle (eq. 21–22); the baseline one way for all, the
     // way most of the area prefers.
-    let own: Vec<Crossfeed> = views
+    let own: Vec<Crossfeed> = isoparametric::patch_views(&cut)
         .iter()
         .map(isoparametric::preferred_crossfeed)
         .collect();
     let crossfeeds: Vec<Crossfeed> = match (opts.crossfeed, with_features) {
-        (Some(c), _) => vec![c; views.len()],
+        (Some(c), _) => vec![c; own.len()],
         (None, true) => own,
         (None, false) => {
             let area = |k: usize| {
-                let r = &chart[k];
+                let r = &rect_charts[k];
                 (r[1] - r[0]) * (r[3] - r[2])
             };
             let along_u: f64 = (0..own.len())
@@ -106,7 +103,7 @@ pub fn plan(
             } else {
                 Crossfeed::U
             };
-            vec![c; views.len()]
+            vec![c; own.len()]
         }
     };
     let name = if with_features {
@@ -117,43 +114,23 @@ pub fn plan(
     let mut planned = pipeline::plan_with(&cut, opts, progress, DRAFT_SHARE, |p| {
         isoparametric::draft_with(&cut, opts, p, Some(&crossfeeds), name)
     })?;
-    let regions = found
-        .features
-        .iter()
-        .filter(|_| with_features)
-        .map(|f| {
-            let label = f.region.label;
-            let area_mm2 = rects
-                .iter()
-                .enumerate()
-                .filter(|(_, r)| r.feature == Some(label))
-                .map(|(k, _)| {
-                    Footprint {
-                        patch: k as u32,
-                        rect: [0.0, 1.0, 0.0, 1.0],
-                    }
-                    .area_mm2_fine(&cut, AREA_SAMPLES)
-                })
-                .sum();
-            RegionReport {
-                kind: f.kind,
-                area_mm2,
-                boxes: 0,
-            }
-        })
-        .collect::<Vec<_>>();
-    let mut regions = regions;
-    if with_features {
-        for (label, _, _) in found.boxes(DEFAULT_TOR) {
-            if let Some(r) = regions.get_mut(label as usize - 1) {
-                r.boxes += 1;
+    // Each region's area: its rectangles' on the surface.
+    let regions = regions.map(|mut regions| {
+        for (k, r) in rects.iter().enumerate() {
+            if let Some(x) = r.feature.and_then(|l| regions.get_mut(l as usize - 1)) {
+                x.area_mm2 += Footprint {
+                    patch: k as u32,
+                    rect: [0.0, 1.0, 0.0, 1.0],
+                }
+                .area_mm2_fine(&cut, AREA_SAMPLES);
             }
         }
-    }
+        regions
+    });
     planned.watershed = Some(WatershedStats {
         regions,
+        map_points,
         rectangle_regions: rects.iter().map(|r| r.feature.map(|l| l - 1)).collect(),
-        map_points: [found.map.valid.nx, found.map.valid.ny],
     });
     planned.layout = Some(cut.layout.clone());
     Ok(planned)
