@@ -205,3 +205,53 @@ fn valence_five_gives_corner_connections() {
         5
     );
 }
+
+#[test]
+fn patches_of_a_component_laid_out_cell_by_cell_connect_along_their_sides() {
+    // Issue 13: Bike.tsm and face.tsm are laid out one patch per cell (their faces do not
+    // form one rectangle), and the sides between those cells were recorded as corner
+    // connections only, so the patch order saw no shared side. Every boundary connection must
+    // be a stretch of side the two patches really share.
+    for (file, least) in [("Bike.tsm", 100), ("face.tsm", 200)] {
+        let path = format!("{}/www/models/grapetec/{file}", env!("CARGO_MANIFEST_DIR"));
+        let m = tspath::io::load(&std::fs::read(&path).unwrap(), file).unwrap();
+        let tol = 1e-7 * m.surface.bbox().diagonal();
+        let side = |p: &tspath::layout::Patch, s: u8, n: usize| -> Vec<tspath::geom::Point3> {
+            (0..=n)
+                .map(|k| {
+                    let t = k as f64 / n as f64;
+                    let (u, v) = [(t, 0.0), (1.0, t), (t, 1.0), (0.0, t)][s as usize];
+                    p.subs(&m.surface, u, v)
+                })
+                .collect()
+        };
+        // Points of `a` within `tol` of the polyline `b` (dense enough to be the curve).
+        let on = |a: &[tspath::geom::Point3], b: &[tspath::geom::Point3]| {
+            a.iter()
+                .filter(|q| {
+                    b.windows(2).any(|w| {
+                        let d = w[1] - w[0];
+                        let t = ((*q - w[0]).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+                        (w[0] + d * t - *q).norm() < tol.max(1e-4 * d.norm())
+                    })
+                })
+                .count()
+        };
+        let boundary: Vec<_> = m
+            .layout
+            .connections
+            .iter()
+            .filter(|c| c.kind == ConnectionKind::Boundary)
+            .collect();
+        println!("{file}: {} boundary connections", boundary.len());
+        assert!(boundary.len() >= least, "{file}: {}", boundary.len());
+        for c in boundary {
+            let (sa, sb) = c.sides.unwrap();
+            let pa = &m.layout.patches[c.a as usize];
+            let pb = &m.layout.patches[c.b as usize];
+            let shared = on(&side(pa, sa, 32), &side(pb, sb, 2048))
+                + on(&side(pb, sb, 32), &side(pa, sa, 2048));
+            assert!(shared >= 4, "{file}: patches {} and {}: {shared}", c.a, c.b);
+        }
+    }
+}

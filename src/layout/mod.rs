@@ -349,10 +349,9 @@ impl PatchLayout {
                 });
             }
         };
-        for &(ca, cb, ha, hb, cut) in &links {
-            if !cut {
-                continue;
-            }
+        // Every link between cells of different patches: cut edges, and the uncut edges
+        // inside a component that could not be laid out as one rectangle.
+        for &(ca, cb, ha, hb, _) in &links {
             let (pa, pb) = (patch_of_cell[ca], patch_of_cell[cb]);
             let sa = patches[pa as usize].side_of(mesh, &cells.cells[ca], ha);
             let sb = patches[pb as usize].side_of(mesh, &cells.cells[cb], hb);

@@ -27,6 +27,12 @@ use crate::geom::Point3;
 /// Relative growth allowed for metric and second-derivative norms between a cell's corners
 /// and its interior (dimensionless).
 pub const INTERIOR_MARGIN: f64 = 0.05;
+/// Deepest gouge, as a share of the ball radius, that the gouge bound is worked out for
+/// (dimensionless): deeper is a crash, not a tolerance question.
+const GOUGE_BOUNDED_SHARE: f64 = 0.25;
+/// Growth of the distance curvature over what the last round needed, so that the rounds
+/// of the gouge bound settle (dimensionless).
+const GOUGE_K_GROWTH: f64 = 1.05;
 /// Rounds of raising the height estimate before a cell is given up as unbounded.
 const MAX_ROUNDS: usize = 12;
 
@@ -38,6 +44,10 @@ pub struct Corner {
     pub reached: bool,
     /// Material left along the normal (mm); negative is a gouge.
     pub left_mm: f64,
+    /// How deep the point lies inside the swept volume, measured straight (mm): the ball
+    /// radius less the distance to the nearest capsule's segment, 0 outside (the gouge
+    /// reported; never more than `−left_mm`).
+    pub straight_mm: f64,
     /// `∂e/∂u`, `∂e/∂v` of the governing capsule's distance (mm per unit parameter).
     pub grad: [f64; 2],
     /// `r·cos θ`: height of the governing ball's centre over the entry point along the
@@ -94,9 +104,11 @@ fn remainder(c: &[&Corner; 4], k: f64, l: f64) -> [f64; 2] {
     let gmax = c.iter().map(|c| c.metric[2]).fold(0.0, f64::max);
     let fabs = c.iter().map(|c| c.metric[1].abs()).fold(0.0, f64::max);
     let [suu, suv, svv] = [0, 1, 2].map(|i| c.iter().map(|c| c.second[i]).fold(0.0, f64::max));
-    // 2|F δu δv| ≤ |F| (ρ δu² + δv²/ρ), balanced by ρ = sqrt(G/E).
-    let rho = if emax > 0.0 {
-        (gmax / emax).sqrt()
+    // 2|F δu δv| ≤ |F| (ρ δu² + δv²/ρ) for any ρ > 0; ρ = sqrt(E/G) adds at most |F|/sqrt(EG)
+    // ≤ 1 of each diagonal term (the other way round a thin, stretched cell's short side
+    // would take the long side's metric).
+    let rho = if gmax > 0.0 {
+        (emax / gmax).sqrt()
     } else {
         1.0
     };
@@ -208,16 +220,64 @@ fn max_of_min_parabolas(a: f64, b: f64, len: f64, h: f64) -> f64 {
     best
 }
 
+/// Upper bound of the deepest gouge in the cell (see [`cell_bound`]); no larger than `best`
+/// when it cannot exceed it, `r` when it cannot be bounded below a quarter radius.
+fn gouge_bound(c: &[&Corner; 4], frame: &CellFrame, r: f64, best: f64) -> f64 {
+    let CellFrame { du, dv, boundary } = *frame;
+    let depths = [0, 1, 2, 3].map(|i| c[i].straight_mm);
+    let deepest = depths.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let bounded = GOUGE_BOUNDED_SHARE * r;
+    // The distance to the deepest capsule's segment, `1/k` bounding its curvature, falls
+    // from `r − D` at the bottom by at most the remainder over the cell: raise `k` until it
+    // covers the distance its own bound allows.
+    let mut k = 1.0 / r;
+    for _ in 0..MAX_ROUNDS {
+        let h = remainder(c, k, 1.0);
+        let spread = 0.5 * (h[0] * du * du + h[1] * dv * dv);
+        let cheap = deepest + 0.125 * (h[0] * du * du + h[1] * dv * dv);
+        let g = if cheap <= best {
+            cheap
+        } else {
+            let mut g = max_of_min_quadratics(depths, [[0.0; 2]; 4], du, dv, h).0;
+            for (edge, &on) in boundary.iter().enumerate() {
+                if on {
+                    let (a, b, len, hh) = match edge {
+                        0 => (depths[0], depths[1], du, h[0]),
+                        1 => (depths[1], depths[3], dv, h[1]),
+                        2 => (depths[2], depths[3], du, h[0]),
+                        _ => (depths[0], depths[2], dv, h[1]),
+                    };
+                    g = g.max(max_of_min_parabolas(a, b, len, hh));
+                }
+            }
+            g
+        };
+        let room = r - g.max(0.0) - spread;
+        if !(g <= bounded) || !(room > 0.0) {
+            return r;
+        }
+        if k * room >= 1.0 {
+            return g;
+        }
+        k = GOUGE_K_GROWTH / room;
+    }
+    r
+}
+
 /// Bounds of the cell with corners `c` (order (0,0), (du,0), (0,dv), (du,dv)) for a ball
 /// of radius `r`. Material beyond `reach` is not scallop (the tool never came near), so the
 /// scallop bound is capped there. Cells whose bounds cannot exceed `best` (scallop, gouge)
 /// skip the exact step and return cheaper bounds that are still no larger than `best`.
 ///
-/// Gouges: the bottom `x*` of a gouge of depth `D` by any capsule `j` (whether or not it
-/// governs a corner) is a critical point of its depth, and its curvature is bounded by `H`
-/// there, so every corner sees `−h_k ≥ −e_j(x_k) ≥ D − ½ δ_kᵀHδ_k`: `D` is at most
-/// `max_x min_k (−h_k + ½ δ_kᵀHδ_k)`. On the patch boundary the bottom may have a slope
-/// across the edge; along the edge it has none, so the edge's two corners bound it.
+/// Gouges: a gouge's depth measured straight is `D(x) = max_j (r − |S(x) − c_j(x)|)` over
+/// the capsules' segments, and its deepest point `x*` in the cell is a critical point of the
+/// capsule `j` deepest there. Along the surface `−(r − dist_j)'' ≤ |S'|²/dist_j + |S''|`
+/// (the distance to a segment is convex in space, its gradient a unit vector), and
+/// `dist_j ≥ r − D(x*) − diam` across the cell, so every corner sees
+/// `D_k ≥ D(x*) − ½ δ_kᵀHδ_k`: `D` is at most `max_x min_k (D_k + ½ δ_kᵀHδ_k)`. On the patch
+/// boundary the bottom may have a slope across the edge; along the edge it has none, so the
+/// edge's two corners bound it. A bound above a quarter of the radius is not attempted
+/// (`r` is returned).
 pub fn cell_bound(
     c: &[&Corner; 4],
     frame: &CellFrame,
@@ -225,39 +285,15 @@ pub fn cell_bound(
     reach: f64,
     best: [f64; 2],
 ) -> CellBound {
-    let CellFrame { du, dv, boundary } = *frame;
+    let CellFrame { du, dv, .. } = *frame;
     let diam = (c[0].point - c[3].point)
         .norm()
         .max((c[1].point - c[2].point).norm());
     let kappa = c.iter().map(|c| c.kappa_convex).fold(0.0, f64::max);
     let slope = c.iter().map(|c| c.slope).fold(0.0, f64::max);
-    let base = 1.0 / r + kappa;
     let quarter = [0.25 * du * du, 0.25 * dv * dv];
 
-    // Gouges: near its bottom a dipping ball is nearly level (it rises by less than
-    // base·diam² over the cell), which bounds its curvature there.
-    let k0 = second_derivative_bound(r, kappa, r - base * diam * diam, 0.0);
-    let h0 = remainder(c, k0, k0 * diam);
-    let depths = [0, 1, 2, 3].map(|i| -c[i].left_mm);
-    let deepest = depths.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let cheap_gouge = deepest + 0.5 * (h0[0] * quarter[0] + h0[1] * quarter[1]);
-    let gouge_upper_mm = if cheap_gouge <= best[1] {
-        cheap_gouge
-    } else {
-        let mut g = max_of_min_quadratics(depths, [[0.0; 2]; 4], du, dv, h0).0;
-        for (edge, &on) in boundary.iter().enumerate() {
-            if on {
-                let (a, b, len, h) = match edge {
-                    0 => (depths[0], depths[1], du, h0[0]),
-                    1 => (depths[1], depths[3], dv, h0[1]),
-                    2 => (depths[2], depths[3], du, h0[0]),
-                    _ => (depths[0], depths[2], dv, h0[1]),
-                };
-                g = g.max(max_of_min_parabolas(a, b, len, h));
-            }
-        }
-        g
-    };
+    let gouge_upper_mm = gouge_bound(c, frame, r, best[1]);
     let best = best[0];
 
     if c.iter().any(|c| !(c.w_mm > 0.0)) {

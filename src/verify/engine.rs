@@ -238,6 +238,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
             point,
             reached: false,
             left_mm: f64::INFINITY,
+            straight_mm: 0.0,
             grad: [0.0; 2],
             w_mm: 0.0,
             slope: 0.0,
@@ -281,6 +282,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
     } else {
         f64::INFINITY
     };
+    let overcut_mm = overcut(probe, &d.point, &n, left_mm);
     let (k_lo, k_hi) = g.principal();
     let k_min_tool_side = if ctx.sigma > 0.0 { k_lo } else { -k_hi };
     Sample {
@@ -288,6 +290,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
             point: d.point,
             reached: true,
             left_mm,
+            straight_mm: overcut_mm,
             grad,
             w_mm,
             slope,
@@ -299,7 +302,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
         singular: false,
         area_density,
         rest,
-        overcut_mm: overcut(probe, &d.point, &n, left_mm),
+        overcut_mm,
     }
 }
 
@@ -429,7 +432,8 @@ fn band(
                     boundary: [j == 1, i + 2 == nu, j + 1 == nv, i == 0],
                 };
                 let mut b = cell_bound(&c, &frame, r, ctx.reach, best);
-                let in_rest = prev[i].rest || prev[i + 1].rest || row[i].rest || row[i + 1].rest;
+                let corner_rest = [prev[i].rest, prev[i + 1].rest, row[i].rest, row[i + 1].rest];
+                let in_rest = corner_rest.iter().any(|&x| x);
                 // A cell whose bound would raise the error bound is sampled more finely
                 // (near extraordinary points and tight folds the metric and the curvature
                 // change too much across a cell for its corners to bound it).
@@ -449,6 +453,7 @@ fn band(
                         fi,
                         origin,
                         &corners,
+                        corner_rest,
                         &frame,
                         above,
                         REFINE_DEPTH,
@@ -458,6 +463,22 @@ fn band(
                     }
                 }
                 acc.gouge_upper = max_opt(acc.gouge_upper, Some(b.gouge_upper_mm));
+                if std::env::var("TSDBG").is_ok() && b.gouge_upper_mm > 0.003 {
+                    eprintln!(
+                        "fi {fi} i {i} j {j} gup {:.5} rest {corner_rest:?} c {:?}",
+                        b.gouge_upper_mm,
+                        c.iter()
+                            .map(|k| (
+                                k.left_mm,
+                                k.w_mm,
+                                k.kappa_convex,
+                                k.grad,
+                                k.metric,
+                                k.second
+                            ))
+                            .collect::<Vec<_>>()
+                    );
+                }
                 if in_rest {
                     // Part of the cell is rest area: its material left is not a scallop.
                     continue;
@@ -499,6 +520,7 @@ fn refined_bound(
     fi: usize,
     origin: (f64, f64),
     c: &[Corner; 4],
+    in_rest: [bool; 4],
     frame: &CellFrame,
     above: [f64; 2],
     depth: usize,
@@ -507,6 +529,11 @@ fn refined_bound(
     let (du, dv) = (0.5 * frame.du, 0.5 * frame.dv);
     // A 3 × 3 grid: the old corners and five new samples.
     let mut g: [[Option<Corner>; 3]; 3] = [[None; 3]; 3];
+    // Which of the nine lie in the rest area (the old corners as the caller found them).
+    let mut rest = [[false; 3]; 3];
+    for (k, (a, b)) in [(0, 0), (2, 0), (0, 2), (2, 2)].into_iter().enumerate() {
+        rest[a][b] = in_rest[k];
+    }
     g[0][0] = Some(c[0]);
     g[2][0] = Some(c[1]);
     g[0][2] = Some(c[2]);
@@ -519,10 +546,14 @@ fn refined_bound(
             (origin.0 + du * a as f64).min(1.0),
             (origin.1 + dv * b as f64).min(1.0),
         );
-        if !s.corner.reached || s.singular || s.rest {
+        if !s.corner.reached || s.singular {
             return None;
         }
-        acc.note_left(Some(s.corner.left_mm), Some(s.corner.point));
+        if s.rest {
+            rest[a][b] = true;
+        } else {
+            acc.note_left(Some(s.corner.left_mm), Some(s.corner.point));
+        }
         acc.note_gouge(s.overcut_mm, Some(s.corner.point));
         acc.refined += 1;
         g[a][b] = Some(s.corner);
@@ -543,14 +574,24 @@ fn refined_bound(
         };
         let refs = [&corners[0], &corners[1], &corners[2], &corners[3]];
         let sub_origin = (origin.0 + du * a as f64, origin.1 + dv * b as f64);
+        let sub_rest = [
+            rest[a][b],
+            rest[a + 1][b],
+            rest[a][b + 1],
+            rest[a + 1][b + 1],
+        ];
         let mut sb = cell_bound(&refs, &sub, ctx.radius, ctx.reach, [f64::NEG_INFINITY; 2]);
-        if (sb.scallop_upper_mm > above[0] || sb.gouge_upper_mm > above[1]) && depth > 1 {
+        let in_rest = sub_rest.iter().any(|&x| x);
+        if ((!in_rest && sb.scallop_upper_mm > above[0]) || sb.gouge_upper_mm > above[1])
+            && depth > 1
+        {
             if let Some(fine) = refined_bound(
                 ctx,
                 probe,
                 fi,
                 sub_origin,
                 &corners,
+                sub_rest,
                 &sub,
                 above,
                 depth - 1,
@@ -558,6 +599,11 @@ fn refined_bound(
             ) {
                 sb = fine;
             }
+        }
+        if in_rest {
+            // Part of it is rest area: its material left is not a scallop.
+            sb.scallop_upper_mm = f64::NEG_INFINITY;
+            sb.argmax = None;
         }
         // The cusp the bound located, relative to the whole cell's corner 0.
         let argmax = sb

@@ -15,7 +15,7 @@ mod spots;
 
 use super::{Move, MoveKind, Toolpath};
 use crate::error::{Error, Result};
-use crate::geom::Point3;
+use crate::geom::{Point3, Vector3};
 use crate::model::Model;
 use crate::tmesh::{Scheme, TMesh};
 use nearest::Nearest;
@@ -39,6 +39,9 @@ pub struct GougeStats {
     pub inserted: usize,
 }
 
+/// Least cosine between the way a first cut point after an approach would be lifted and its
+/// own surface normal (dimensionless; 60°).
+const PLUNGE_LIFT_COS: f64 = 0.5;
 /// Lifting rounds per CL point (each moves it away from the then nearest point).
 const LIFT_ROUNDS: usize = 8;
 /// Moves between two checks for cancellation.
@@ -97,10 +100,15 @@ pub fn lift(
         if i % CANCEL_EVERY == 0 && !keep_going() {
             return Err(Error::Cancelled);
         }
-        if !matches!(m.kind, MoveKind::Feed | MoveKind::Link) || !spots.near(&m.cl_point) {
+        // Every move ending on the surface, the first cut point after an approach too.
+        if !m.kind.on_surface() || !spots.near(&m.cl_point) {
             continue;
         }
-        let Some(l) = lift_one(&near, m.cl_point, r, tol, &[], &mut stats) else {
+        // The first cut point after an approach is lifted only off a surface facing it
+        // (within 60° of its own normal): at a fold, moving it away from the nearest point
+        // would take it to the far side, and the move to the next lifted point through.
+        let own_side = (m.kind == MoveKind::Plunge).then(|| m.cl_point - m.cc_point);
+        let Some(l) = lift_one(&near, m.cl_point, r, tol, &[], own_side, &mut stats) else {
             continue;
         };
         lifted[i] = true;
@@ -187,10 +195,12 @@ fn lift_one(
     r: f64,
     tol: f64,
     hints: &[(u32, [f64; 2])],
+    own_side: Option<Vector3>,
     stats: &mut GougeStats,
 ) -> Option<Lifted> {
     let (d, q) = near.nearest_from(&c, r, hints)?;
-    if d >= r - tol {
+    let off_side = |n: Vector3| (c - q).dot(&n) < PLUNGE_LIFT_COS * d * n.norm();
+    if d >= r - tol || own_side.is_some_and(off_side) {
         return None;
     }
     if r - d > stats.worst_mm {
@@ -248,7 +258,7 @@ fn split_segment(
         return;
     }
     let mid = ma.cl_point + (mb.cl_point - ma.cl_point) * 0.5;
-    let (centre, contact) = match lift_one(near, mid, r, tol, hints, stats) {
+    let (centre, contact) = match lift_one(near, mid, r, tol, hints, None, stats) {
         Some(l) => (l.centre, l.contact),
         None => (
             mid,
