@@ -175,8 +175,16 @@ pub fn finish(
     //    the scallop at their contact point.
     let footprints = (0..n)
         .filter_map(|i| {
-            let w = why[i].or((left[i] > opts.scallop_mm || tight[i]).then_some(Why::TooTight))?;
-            Some((draft.footprints[i], w))
+            if let Some(w) = why[i] {
+                return Some((draft.footprints[i], w, 1.0));
+            }
+            // Kept, but leaving too much: the share of its footprint measured above h.
+            let share = tight[i].max(if left[i] > opts.scallop_mm {
+                reach::ONE_SAMPLE_SHARE
+            } else {
+                0.0
+            });
+            (share > 0.0).then_some((draft.footprints[i], Why::TooTight, share))
         })
         .collect();
     let halves = reach::cut_end_halves(&draft, &why);

@@ -52,7 +52,8 @@ impl Why {
 pub struct RestRegion {
     pub patch: u32,
     pub why: Why,
-    /// Its area (mm²).
+    /// Its area (mm²): of footprints left too tight, the share measured above the scallop
+    /// (see [`tight_near_lifts`]); of the others, the whole footprint.
     pub area_mm2: f64,
     /// A point of it on the surface (mm): the middle of its piece nearest its area-weighted
     /// mean.
@@ -202,6 +203,8 @@ fn split_runs(runs: &[PatchRun], moves: &[Move], origin: &[u32]) -> Vec<PatchRun
 /// two lifted balls along a pass can be narrower than a quarter of the footprint: at 5 the
 /// search missed a 1.034 h cusp on face.tsm (r 0.5, h 0.01 mm); 9 holds the 5 × 5 points too.
 const TIGHT_SAMPLES: usize = 9;
+/// The share of a footprint one of its grid samples stands for.
+pub const ONE_SAMPLE_SHARE: f64 = 1.0 / (TIGHT_SAMPLES * TIGHT_SAMPLES) as f64;
 /// Halvings of the pattern search for the highest material left in a footprint: it starts
 /// at half the grid step and ends at 1/1024 of the footprint.
 const TIGHT_SEARCH_HALVINGS: usize = 9;
@@ -233,16 +236,18 @@ const PATTERN: [(f64, f64); 8] = [
 /// contact point (`left`) and widens the cusps to the passes beside it, which the side steps
 /// did not foresee. Every footprint touching a lifted point's is measured at a few points
 /// with the swept balls of `path` (the draft after lifting: the cuts as moves on the surface),
-/// as the cutting simulation measures them. Returns one flag per move.
+/// as the cutting simulation measures them. Returns per move the share of its footprint
+/// left above the scallop: the share of its grid samples that are, at least one sample's
+/// worth where only the search found the peak, and 0 where nothing is.
 pub fn tight_near_lifts(
     model: &Model,
     path: &Toolpath,
     footprints: &[Footprint],
     left: &[f64],
     scallop_mm: f64,
-) -> Vec<bool> {
+) -> Vec<f64> {
     let n = path.moves.len();
-    let mut tight = vec![false; n];
+    let mut tight = vec![0.0; n];
     let r = path.tool_radius_mm;
     let lifted: Vec<usize> = (0..n)
         .filter(|&i| left.get(i).is_some_and(|&l| l > 0.0) && path.moves[i].kind.on_surface())
@@ -451,7 +456,22 @@ pub fn tight_near_lifts(
                 top = top.max(best.0).max(f1).max(f2);
             }
         }
-        tight[i] = top > scallop_mm;
+        if top > scallop_mm {
+            // Trapezoid weights: the footprint's sides are shared with its neighbours'.
+            let edge = |a: usize| {
+                if a == 0 || a + 1 == TIGHT_SAMPLES {
+                    0.5
+                } else {
+                    1.0
+                }
+            };
+            let above: f64 = (0..TIGHT_SAMPLES)
+                .flat_map(|a| (0..TIGHT_SAMPLES).map(move |b| (a, b)))
+                .filter(|&(a, b)| at_grid(a, b) > scallop_mm)
+                .map(|(a, b)| edge(a) * edge(b))
+                .sum();
+            tight[i] = (above / (k * k)).max(ONE_SAMPLE_SHARE);
+        }
     }
     tight
 }
@@ -540,23 +560,25 @@ pub fn cut_end_halves(draft: &Draft, skip: &[Option<Why>]) -> Vec<(Footprint, Wh
     out
 }
 
-/// The rest area of `footprints` (cut points left out, or kept but leaving too much) and of
-/// `halves` (parts of kept points' footprints, see [`cut_end_halves`]: area, but no cut
+/// The rest area of `footprints` (cut points left out, or kept but leaving too much, each
+/// with the share of its area that counts) and of `halves` (parts of kept points' footprints, see [`cut_end_halves`]: area, but no cut
 /// points of their own) on `model`, its regions located against the final `path`.
 pub fn rest(
     model: &Model,
-    footprints: Vec<(Footprint, Why)>,
+    footprints: Vec<(Footprint, Why, f64)>,
     halves: Vec<(Footprint, Why)>,
     path: &Toolpath,
 ) -> Rest {
     let n_points = footprints.len();
-    let (fps, is_point): (Vec<(Footprint, Why)>, Vec<bool>) = footprints
+    let (fws, is_point): (Vec<(Footprint, Why, f64)>, Vec<bool>) = footprints
         .into_iter()
-        .chain(halves)
+        .chain(halves.into_iter().map(|(f, w)| (f, w, 1.0)))
         .enumerate()
-        .filter(|(_, (f, _))| !f.is_none())
+        .filter(|(_, (f, ..))| !f.is_none())
         .map(|(k, fw)| (fw, k < n_points))
         .unzip();
+    let share: Vec<f64> = fws.iter().map(|fw| fw.2).collect();
+    let fps: Vec<(Footprint, Why)> = fws.into_iter().map(|(f, w, _)| (f, w)).collect();
     let n = fps.len();
     let mut sets = Sets((0..n).collect());
     // Footprints of one patch and reason touching each other join: bucketed by patch and
@@ -606,7 +628,7 @@ pub fn rest(
             members.push(Vec::new());
         }
         members[index_of_root[root]].push(i);
-        let a = fps[i].0.area_mm2(model);
+        let a = fps[i].0.area_mm2(model) * share[i];
         let c = centres[i];
         let e = &mut acc[index_of_root[root]];
         e.2 += a;
@@ -746,20 +768,29 @@ mod tests {
             patch: 0,
             rect: [u0, u1, v0, v1],
         };
+        let tight = fp(0.8, 0.9, 0.8, 0.9);
         let fps = vec![
-            (fp(0.0, 0.1, 0.0, 0.1), Why::ToolHits),
-            (fp(0.1, 0.2, 0.0, 0.1), Why::ToolHits),
-            (fp(0.15, 0.3, 0.1, 0.2), Why::ToolHits),
-            (fp(0.5, 0.6, 0.5, 0.6), Why::ToolHits),
-            (fp(0.6, 0.7, 0.5, 0.6), Why::FacesAway),
-            (Footprint::NONE, Why::ToolHits),
+            (fp(0.0, 0.1, 0.0, 0.1), Why::ToolHits, 1.0),
+            (fp(0.1, 0.2, 0.0, 0.1), Why::ToolHits, 1.0),
+            (fp(0.15, 0.3, 0.1, 0.2), Why::ToolHits, 1.0),
+            (fp(0.5, 0.6, 0.5, 0.6), Why::ToolHits, 1.0),
+            (fp(0.6, 0.7, 0.5, 0.6), Why::FacesAway, 1.0),
+            (Footprint::NONE, Why::ToolHits, 1.0),
+            // Kept, a quarter of it measured above the scallop.
+            (tight, Why::TooTight, 0.25),
         ];
         let whole = fp(0.0, 1.0, 0.0, 1.0).area_mm2(&m);
         let rest = rest(&m, fps, Vec::new(), &Toolpath::default());
-        assert_eq!(rest.regions.len(), 3);
+        assert_eq!(rest.regions.len(), 4);
         assert_eq!(rest.regions[0].points, 3);
         let sum: f64 = rest.regions.iter().map(|r| r.area_mm2).sum();
         assert!((sum - rest.area_mm2).abs() < 1e-9);
         assert!(rest.area_mm2 > 0.0 && rest.area_mm2 < whole);
+        let t = rest
+            .regions
+            .iter()
+            .find(|r| r.why == Why::TooTight)
+            .unwrap();
+        assert!((t.area_mm2 - 0.25 * tight.area_mm2(&m)).abs() < 1e-12);
     }
 }
