@@ -24,6 +24,8 @@ pub mod machine;
 pub mod model;
 pub mod plan;
 pub mod surface;
+#[cfg(test)]
+mod testing;
 pub mod tmesh;
 pub mod verify;
 pub mod wasm;

@@ -368,43 +368,20 @@ fn the_public_tsm_files_plan_with_zero_gouges_and_keep_their_scallop_where_reach
 }
 
 #[test]
-fn face_tsm_at_the_page_defaults_keeps_its_scallop_beside_lifted_balls() {
+fn the_public_tsm_files_at_the_page_defaults_keep_their_scallop_and_prove_it() {
     // Issue 13, 3: at r 0.5, h 0.01 mm face.tsm left 1.034 h at (−12.881, 12.192, 0.916) mm,
     // between two balls lifted off the crease at a patch seam, outside the rest area: the
     // search for the material lifted balls leave, on a 5 × 5 grid per footprint, missed
-    // that narrow peak. Now everything above h is in the rest area, and no gouge.
-    let m = public_tsm("face.tsm");
-    let opts = PlanOptions::default()
-        .with_tool_radius(0.5)
-        .with_scallop(0.01);
-    let (_, report, v) = plan_and_verify(&m, &opts);
-    println!(
-        "face.tsm r 0.5 h 0.01: max scallop {:.5} mm at {:?} (bound {:.5} mm, {} samples), rest {:.2} mm², gouges {}",
-        v.max_scallop_mm, v.max_scallop_at_mm, v.error_bound_mm, v.samples, report.unreachable_area_mm2, v.gouge_count
-    );
-    assert!(v.error_bound_mm <= 0.25 * opts.scallop_mm);
-    assert_eq!(v.gouge_count, 0);
-    rest_matches_the_uncut_area("face.tsm", &report, &v);
-    assert!(
-        v.max_scallop_mm <= opts.scallop_mm,
-        "{} mm left outside the rest area at {:?}",
-        v.max_scallop_mm,
-        v.max_scallop_at_mm
-    );
-    assert!(!report.problems.iter().any(|p| p.kind == "scallop"));
-}
-
-#[test]
-fn the_public_tsm_files_at_the_page_defaults_keep_their_scallop_and_prove_it() {
-    // Issue 13, 3: at r 0.5, h 0.01 mm Bike.tsm left 1.025 h at (3.554, −14.723, 10.204) mm
+    // that narrow peak; now everything above h is in the rest area.
+    // Bike.tsm left 1.025 h at (3.554, −14.723, 10.204) mm
     // (a pass end on patch 52) and its simulation could not bound its gouges better than
     // 3.04 mm at 8 M samples: on a sliver face (0.024 mm across) the bound balanced the
     // metric's cross term the wrong way round, and measured gouges along the normal where
     // the straight depth is what is reported. With the patches of its one-patch-per-cell
     // layout connected along their sides the order changed, the first cut point after an
-    // approach is lifted like every other, and the bound is below h / 4. (face.tsm has its
-    // own test above.)
+    // approach is lifted like every other, and the bound is below h / 4.
     for file in [
+        "face.tsm",
         "Bike.tsm",
         "simple.tsm",
         "mouse.tsm",

@@ -332,13 +332,7 @@ mod tests {
         let m = crate::model::samples::load_sample("keycap-convex").unwrap();
         let dist = SurfaceDistance::new(&m, 0.01);
         let bb = m.surface.bbox();
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(12345u64);
         let mut agree = 0;
         for _ in 0..200 {
             let p = |r: &mut dyn FnMut() -> f64| {

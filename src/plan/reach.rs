@@ -570,15 +570,13 @@ pub fn rest(
     path: &Toolpath,
 ) -> Rest {
     let n_points = footprints.len();
-    let (fws, is_point): (Vec<(Footprint, Why, f64)>, Vec<bool>) = footprints
+    let ((fps, share), is_point): ((Vec<_>, Vec<f64>), Vec<bool>) = footprints
         .into_iter()
         .chain(halves.into_iter().map(|(f, w)| (f, w, 1.0)))
         .enumerate()
         .filter(|(_, (f, ..))| !f.is_none())
-        .map(|(k, fw)| (fw, k < n_points))
+        .map(|(k, (f, w, s))| (((f, w), s), k < n_points))
         .unzip();
-    let share: Vec<f64> = fws.iter().map(|fw| fw.2).collect();
-    let fps: Vec<(Footprint, Why)> = fws.into_iter().map(|(f, w, _)| (f, w)).collect();
     let n = fps.len();
     let mut sets = Sets((0..n).collect());
     // Footprints of one patch and reason touching each other join: bucketed by patch and

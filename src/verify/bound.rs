@@ -44,10 +44,12 @@ pub struct Corner {
     pub reached: bool,
     /// Material left along the normal (mm); negative is a gouge.
     pub left_mm: f64,
-    /// How deep the point lies inside the swept volume, measured straight (mm): the ball
-    /// radius less the distance to the nearest capsule's segment, 0 outside (the gouge
-    /// reported; never more than `−left_mm`).
-    pub straight_mm: f64,
+    /// How far the cut reaches past the surface here (mm, 0 where it does not): the depth
+    /// inside the swept volume measured straight, the ball radius less the distance to the
+    /// nearest capsule's segment ([`super::probe::Probe::straight_depth`]; never more than
+    /// `−left_mm`, which along the normal can run under the other side of a concave crease).
+    /// The gouge reported.
+    pub overcut_mm: f64,
     /// `∂e/∂u`, `∂e/∂v` of the governing capsule's distance (mm per unit parameter).
     pub grad: [f64; 2],
     /// `r·cos θ`: height of the governing ball's centre over the entry point along the
@@ -224,7 +226,7 @@ fn max_of_min_parabolas(a: f64, b: f64, len: f64, h: f64) -> f64 {
 /// when it cannot exceed it, `r` when it cannot be bounded below a quarter radius.
 fn gouge_bound(c: &[&Corner; 4], frame: &CellFrame, r: f64, best: f64) -> f64 {
     let CellFrame { du, dv, boundary } = *frame;
-    let depths = [0, 1, 2, 3].map(|i| c[i].straight_mm);
+    let depths = [0, 1, 2, 3].map(|i| c[i].overcut_mm);
     let deepest = depths.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let bounded = GOUGE_BOUNDED_SHARE * r;
     // The distance to the deepest capsule's segment, `1/k` bounding its curvature, falls
@@ -233,8 +235,10 @@ fn gouge_bound(c: &[&Corner; 4], frame: &CellFrame, r: f64, best: f64) -> f64 {
     let mut k = 1.0 / r;
     for _ in 0..MAX_ROUNDS {
         let h = remainder(c, k, 1.0);
+        // Most of `½ δᵀHδ` over the cell, and over a quarter of it (each point's nearest
+        // corner is within half a side each way).
         let spread = 0.5 * (h[0] * du * du + h[1] * dv * dv);
-        let cheap = deepest + 0.125 * (h[0] * du * du + h[1] * dv * dv);
+        let cheap = deepest + 0.25 * spread;
         let g = if cheap <= best {
             cheap
         } else {
@@ -272,8 +276,8 @@ fn gouge_bound(c: &[&Corner; 4], frame: &CellFrame, r: f64, best: f64) -> f64 {
 /// Gouges: a gouge's depth measured straight is `D(x) = max_j (r − |S(x) − c_j(x)|)` over
 /// the capsules' segments, and its deepest point `x*` in the cell is a critical point of the
 /// capsule `j` deepest there. Along the surface `−(r − dist_j)'' ≤ |S'|²/dist_j + |S''|`
-/// (the distance to a segment is convex in space, its gradient a unit vector), and
-/// `dist_j ≥ r − D(x*) − diam` across the cell, so every corner sees
+/// (the distance to a segment is convex in space, its gradient a unit vector), and, its slope
+/// vanishing at `x*`, `dist_j ≥ r − D(x*) − ½ δᵀHδ` across the cell, so every corner sees
 /// `D_k ≥ D(x*) − ½ δ_kᵀHδ_k`: `D` is at most `max_x min_k (D_k + ½ δ_kᵀHδ_k)`. On the patch
 /// boundary the bottom may have a slope across the edge; along the edge it has none, so the
 /// edge's two corners bound it. A bound above a quarter of the radius is not attempted
@@ -476,13 +480,8 @@ mod tests {
 
     #[test]
     fn arrangement_vertices_give_the_maximum() {
-        let mut seed = 99u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut uniform = crate::testing::uniform(99u64);
+        let mut rnd = || uniform() * 2.0 - 1.0;
         for _ in 0..200 {
             let vals = [rnd(), rnd(), rnd(), rnd()].map(|x| 0.01 * x);
             let grads = [0; 4].map(|_| [rnd(), rnd()]);

@@ -232,13 +232,8 @@ mod tests {
     fn agrees_with_marching_on_body_caps_and_misses() {
         let r = 0.7;
         let cap = Capsule::new(Point3::new(0.1, -0.2, 0.3), Point3::new(1.3, 0.4, -0.2));
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut uniform = crate::testing::uniform(12345u64);
+        let mut rnd = || uniform() * 2.0 - 1.0;
         let (mut hits, mut misses) = (0, 0);
         for _ in 0..300 {
             let o = Point3::new(0.7 + 1.5 * rnd(), 1.5 * rnd(), 1.5 * rnd());

@@ -57,11 +57,6 @@ struct Sample {
     area_density: f64,
     /// Inside the plan's rest area (left for another tool).
     rest: bool,
-    /// How far the cut reaches past the surface here (mm, 0 where it does not): the depth
-    /// along the normal, but no more than the straight depth inside the swept volume
-    /// ([`Probe::straight_depth`]), so that a cut under the other side of a concave crease
-    /// is not read as a gouge here.
-    overcut_mm: f64,
 }
 
 /// Running totals of one band or patch.
@@ -238,7 +233,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
             point,
             reached: false,
             left_mm: f64::INFINITY,
-            straight_mm: 0.0,
+            overcut_mm: 0.0,
             grad: [0.0; 2],
             w_mm: 0.0,
             slope: 0.0,
@@ -250,7 +245,6 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
         singular,
         area_density,
         rest,
-        overcut_mm: 0.0,
     };
     let Some((d, g)) = geometry(face, u, v) else {
         return unmeasured(face.subs(u, v), true, 0.0);
@@ -290,7 +284,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
             point: d.point,
             reached: true,
             left_mm,
-            straight_mm: overcut_mm,
+            overcut_mm,
             grad,
             w_mm,
             slope,
@@ -302,12 +296,11 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
         singular: false,
         area_density,
         rest,
-        overcut_mm,
     }
 }
 
 /// The overcut at a point of the surface whose material left along the tool-side normal `n`
-/// is `left_mm` (see [`Sample::overcut_mm`]).
+/// is `left_mm` (see [`Corner::overcut_mm`]).
 fn overcut(probe: &mut Probe, p: &Point3, n: &Vector3, left_mm: f64) -> f64 {
     if left_mm >= 0.0 {
         0.0
@@ -323,8 +316,8 @@ fn heat_value(s: &Sample, tol: f64) -> f32 {
         f32::NAN
     } else if !s.corner.reached {
         f32::INFINITY
-    } else if s.overcut_mm > tol {
-        -s.overcut_mm as f32
+    } else if s.corner.overcut_mm > tol {
+        -s.corner.overcut_mm as f32
     } else {
         s.corner.left_mm.max(0.0) as f32
     }
@@ -386,7 +379,7 @@ fn band(
                 if left > h_req {
                     acc.uncut_area += w;
                 }
-                let cut_in = s.overcut_mm;
+                let cut_in = s.corner.overcut_mm;
                 if cut_in > tol {
                     acc.gouges += 1;
                     acc.gouge_area += w;
@@ -463,22 +456,6 @@ fn band(
                     }
                 }
                 acc.gouge_upper = max_opt(acc.gouge_upper, Some(b.gouge_upper_mm));
-                if std::env::var("TSDBG").is_ok() && b.gouge_upper_mm > 0.003 {
-                    eprintln!(
-                        "fi {fi} i {i} j {j} gup {:.5} rest {corner_rest:?} c {:?}",
-                        b.gouge_upper_mm,
-                        c.iter()
-                            .map(|k| (
-                                k.left_mm,
-                                k.w_mm,
-                                k.kappa_convex,
-                                k.grad,
-                                k.metric,
-                                k.second
-                            ))
-                            .collect::<Vec<_>>()
-                    );
-                }
                 if in_rest {
                     // Part of the cell is rest area: its material left is not a scallop.
                     continue;
@@ -520,7 +497,7 @@ fn refined_bound(
     fi: usize,
     origin: (f64, f64),
     c: &[Corner; 4],
-    in_rest: [bool; 4],
+    corner_rest: [bool; 4],
     frame: &CellFrame,
     above: [f64; 2],
     depth: usize,
@@ -532,7 +509,7 @@ fn refined_bound(
     // Which of the nine lie in the rest area (the old corners as the caller found them).
     let mut rest = [[false; 3]; 3];
     for (k, (a, b)) in [(0, 0), (2, 0), (0, 2), (2, 2)].into_iter().enumerate() {
-        rest[a][b] = in_rest[k];
+        rest[a][b] = corner_rest[k];
     }
     g[0][0] = Some(c[0]);
     g[2][0] = Some(c[1]);
@@ -554,7 +531,7 @@ fn refined_bound(
         } else {
             acc.note_left(Some(s.corner.left_mm), Some(s.corner.point));
         }
-        acc.note_gouge(s.overcut_mm, Some(s.corner.point));
+        acc.note_gouge(s.corner.overcut_mm, Some(s.corner.point));
         acc.refined += 1;
         g[a][b] = Some(s.corner);
     }
@@ -638,7 +615,7 @@ fn gouge_bottom(
     dv: f64,
 ) -> (f64, Point3) {
     let first = measure(ctx, probe, fi, u, v);
-    let mut best = -first.overcut_mm;
+    let mut best = -first.corner.overcut_mm;
     let mut best_at = first.corner.point;
     let mut at = (u, v, first.corner);
     for _ in 0..GOUGE_NEWTON_STEPS {
@@ -663,8 +640,8 @@ fn gouge_bottom(
         if !(next.corner.reached && next.corner.left_mm < at.2.left_mm) {
             break;
         }
-        if -next.overcut_mm < best {
-            best = -next.overcut_mm;
+        if -next.corner.overcut_mm < best {
+            best = -next.corner.overcut_mm;
             best_at = next.corner.point;
         }
         at = (nu, nv, next.corner);

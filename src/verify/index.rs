@@ -230,13 +230,7 @@ mod tests {
     /// length and position relative to the cells.
     #[test]
     fn walk_visits_every_capsule_the_segment_meets() {
-        let mut seed = 4242u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(4242u64);
         let r = 0.4;
         let mut capsules = Vec::new();
         for _ in 0..400 {

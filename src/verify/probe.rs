@@ -199,13 +199,7 @@ mod tests {
     /// point, or the bottom of the swept region containing it.
     #[test]
     fn agrees_with_brute_force_over_all_capsules() {
-        let mut seed = 777u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(777u64);
         let r = 0.5;
         let mut capsules = Vec::new();
         for _ in 0..300 {

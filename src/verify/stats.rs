@@ -51,13 +51,7 @@ mod tests {
 
     #[test]
     fn matches_sorting() {
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(7u64);
         let values: Vec<(f64, f64)> = (0..20_000).map(|_| (rnd().powi(3), rnd())).collect();
         let mut sorted = values.clone();
         sorted.sort_by(|a, b| a.0.total_cmp(&b.0));

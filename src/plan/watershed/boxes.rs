@@ -267,13 +267,7 @@ mod tests {
     /// the paper states; one region may buck it).
     #[test]
     fn boxes_cover_random_regions_once_and_keep_their_fill() {
-        let mut seed = 99u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::testing::uniform(99u64);
         let mut totals = [0usize; 4];
         for _ in 0..200 {
             let (nx, ny) = (5 + (rnd() * 20.0) as usize, 5 + (rnd() * 20.0) as usize);
