@@ -172,22 +172,25 @@ pub fn finish(
     // 4. Turns of the axis between cut points, checked for the shank and holder.
     axis::bridge_turns(&mut path, &obs, opts, &mut axes);
     // 5. The rest area: points left out, and points kept whose lifted ball leaves more than
-    //    the scallop at their contact point.
-    let footprints = (0..n)
+    //    the scallop near their contact point; of each footprint, the share the final path
+    //    leaves above the scallop.
+    let mut rest_fps: Vec<(Footprint, Why)> = (0..n)
         .filter_map(|i| {
-            if let Some(w) = why[i] {
-                return Some((draft.footprints[i], w, 1.0));
-            }
-            // Kept, but leaving too much: the share of its footprint measured above h.
-            let share = tight[i].max(if left[i] > opts.scallop_mm {
-                reach::ONE_SAMPLE_SHARE
-            } else {
-                0.0
-            });
-            (share > 0.0).then_some((draft.footprints[i], Why::TooTight, share))
+            let tight = tight[i] || left[i] > opts.scallop_mm;
+            why[i]
+                .or(tight.then_some(Why::TooTight))
+                .map(|w| (draft.footprints[i], w))
         })
         .collect();
-    let halves = reach::cut_end_halves(&draft, &why);
+    let points = rest_fps.len();
+    rest_fps.extend(reach::cut_end_halves(&draft, &why));
+    let shares = reach::shares_left(model, &path, &rest_fps, opts.scallop_mm);
+    let mut with_share = rest_fps
+        .into_iter()
+        .zip(shares)
+        .map(|((f, w), s)| (f, w, s));
+    let footprints: Vec<_> = with_share.by_ref().take(points).collect();
+    let halves: Vec<_> = with_share.collect();
     let rest = reach::rest(model, footprints, halves, &path);
     let area = model_area(model);
     progress(1.0);

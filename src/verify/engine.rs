@@ -70,6 +70,8 @@ struct Acc {
     area: f64,
     unreached_area: f64,
     uncut_area: f64,
+    /// Area of the cells whose corners disagree on whether more than the scallop is left.
+    uncut_edge_area: f64,
     reached_area: f64,
     scallop_area: f64,
     max_left: Option<f64>,
@@ -100,6 +102,7 @@ impl Acc {
         self.area += o.area;
         self.unreached_area += o.unreached_area;
         self.uncut_area += o.uncut_area;
+        self.uncut_edge_area += o.uncut_edge_area;
         self.reached_area += o.reached_area;
         self.scallop_area += o.scallop_area;
         self.note_left(o.max_left, o.max_left_at);
@@ -412,6 +415,15 @@ fn band(
                         .norm()
                         .max((c[1].point - c[2].point).norm()),
                 );
+                // The uncut area's edge runs through a cell whose measured corners disagree.
+                let cell = [&prev[i], &prev[i + 1], &row[i], &row[i + 1]];
+                let uncut = |s: &Sample| !s.corner.reached || s.corner.left_mm > h_req;
+                let measured = cell.iter().filter(|s| !s.singular);
+                let uncut_corners = measured.clone().filter(|s| uncut(s)).count();
+                if uncut_corners > 0 && uncut_corners < measured.count() {
+                    let density = 0.25 * cell.iter().map(|s| s.area_density).sum::<f64>();
+                    acc.uncut_edge_area += density * du * dv;
+                }
                 if c.iter().any(|c| !c.reached) {
                     continue;
                 }
@@ -808,6 +820,7 @@ fn summarise(patch: u32, grid: [usize; 2], acc: &Acc) -> PatchVerification {
         },
         p95_scallop_mm: weighted_quantile(&acc.values, PERCENTILE).unwrap_or(0.0),
         uncut_fraction: frac(acc.uncut_area),
+        uncut_edge_fraction: frac(acc.uncut_edge_area),
         unreached_fraction: frac(acc.unreached_area),
         unreached_samples: acc.unreached,
         max_gouge_mm: acc.max_gouge.max(0.0),
@@ -913,6 +926,7 @@ pub(super) fn run(
         mean_scallop_mm: o.mean_scallop_mm,
         p95_scallop_mm: o.p95_scallop_mm,
         uncut_fraction: o.uncut_fraction,
+        uncut_edge_fraction: o.uncut_edge_fraction,
         unreached_fraction: o.unreached_fraction,
         unreached_samples: o.unreached_samples,
         rest_fraction: o.rest_fraction,

@@ -243,6 +243,11 @@ pub struct PatchVerification {
     /// Fraction of the area with more material left than the requested scallop, the
     /// unreached area included.
     pub uncut_fraction: f64,
+    /// Fraction of the area in cells of four neighbouring samples that disagree on whether
+    /// more than the requested scallop is left: the uncut area's edge, located only to
+    /// within a cell. The true uncut share lies within `uncut_fraction` ± this, but for
+    /// strips narrower than a cell that no sample meets.
+    pub uncut_edge_fraction: f64,
     /// Fraction of the area no ball came within one tool radius of, along the normal.
     pub unreached_fraction: f64,
     pub unreached_samples: usize,
@@ -289,6 +294,7 @@ pub struct Verification {
     pub mean_scallop_mm: f64,
     pub p95_scallop_mm: f64,
     pub uncut_fraction: f64,
+    pub uncut_edge_fraction: f64,
     pub unreached_fraction: f64,
     pub unreached_samples: usize,
     pub rest_fraction: f64,
