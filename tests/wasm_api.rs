@@ -348,9 +348,9 @@ fn rest_area_reaches_javascript_as_the_report_says() {
     }
     assert!(tight, "the fillets are tighter than the ball");
 
-    // The triangles cover the rest regions: per reason the areas agree, except that a
-    // footprint left too tight is drawn whole while only the share of it measured above the
-    // scallop counts.
+    // The triangles cover the rest regions: footprints are drawn whole while only the share
+    // of each the final path leaves above the scallop counts (of a point left out, most of
+    // it; of one left too tight, a sliver).
     let positions = plan.rest_positions().to_vec();
     let reasons = plan.rest_reasons().to_vec();
     assert_eq!(positions.len(), 9 * reasons.len());
@@ -369,11 +369,8 @@ fn rest_area_reaches_javascript_as_the_report_says() {
     let total = get(&report, "unreachable_area_mm2").as_f64().unwrap();
     assert!((listed.iter().sum::<f64>() - total).abs() < 1e-9 * total.max(1.0));
     for k in 0..4 {
-        let within = if names[k] == "too_tight" {
-            drawn[k] >= 0.95 * listed[k] - 1e-6
-        } else {
-            (drawn[k] - listed[k]).abs() <= 0.05 * listed[k] + 1e-6
-        };
+        let within = drawn[k] >= 0.95 * listed[k] - 1e-6
+            && (names[k] == "too_tight" || listed[k] >= 0.5 * drawn[k]);
         assert!(
             within,
             "{}: triangles {} mm², regions {} mm²",
