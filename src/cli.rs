@@ -13,7 +13,8 @@ const USAGE: &str = "usage:
   tspath sample --list
   tspath sample NAME -o FILE.json
   tspath export MODEL -o FILE.stl|FILE.obj [--chordal MM]
-  tspath plan MODEL [--strategy isoparametric|isfc|watershed|multi-rectangle] [--isfc-plain]
+  tspath plan MODEL [--strategy isoparametric|isfc|watershed|multi-rectangle|isoplanar]
+              [--isfc-plain] [--slice-angle DEG] [--no-deform] [--shear]
               [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--axis-preset vertical|gan2014]
@@ -241,7 +242,11 @@ fn export(args: &[String]) -> Result<String> {
 }
 
 /// Options `plan` and `compare` take.
+/// The plan's switches (flags without a value).
+const PLAN_SWITCHES: &[&str] = &["--verify", "--isfc-plain", "--no-deform", "--shear"];
+
 const PLAN_FLAGS: &[&str] = &[
+    "--slice-angle",
     "--tool-radius",
     "--scallop",
     "--chordal",
@@ -343,11 +348,20 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     if a.has("--isfc-plain") {
         opts.isfc_plain = true;
     }
+    if let Some(v) = a.number("--slice-angle")? {
+        opts.slice_angle_deg = v;
+    }
+    if a.has("--no-deform") {
+        opts.isoplanar_deform = false;
+    }
+    if a.has("--shear") {
+        opts.isoplanar_shear = true;
+    }
     Ok((m, mach, opts))
 }
 
 fn plan(args: &[String]) -> Result<(String, Status)> {
-    let a = parse(args, PLAN_FLAGS, &["--verify", "--isfc-plain"])?;
+    let a = parse(args, PLAN_FLAGS, PLAN_SWITCHES)?;
     let (m, mach, opts) = plan_setup(&a)?;
     let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
     let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
@@ -402,11 +416,7 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
 
 /// `compare`: both strategies on one model, as JSON or a Markdown table row.
 fn compare_cmd(args: &[String]) -> Result<String> {
-    let a = parse(
-        args,
-        PLAN_FLAGS,
-        &["--verify", "--isfc-plain", "--markdown"],
-    )?;
+    let a = parse(args, PLAN_FLAGS, &[PLAN_SWITCHES, &["--markdown"]].concat())?;
     let (m, _, opts) = plan_setup(&a)?;
     let max = if a.has("--verify") {
         Some(

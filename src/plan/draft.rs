@@ -106,6 +106,8 @@ pub struct Draft {
     pub forced_retractions: usize,
     /// What the space-filling curve is made of (`isfc` only).
     pub isfc: Option<super::isfc::IsfcStats>,
+    /// What the slices are made of (`isoplanar` only).
+    pub isoplanar: Option<super::isoplanar::IsoplanarStats>,
 }
 
 /// Builds a [`Draft`] move by move.
@@ -221,6 +223,7 @@ impl DraftBuilder {
             safe_z: self.safe_z,
             forced_retractions,
             isfc: None,
+            isoplanar: None,
         }
     }
 }

@@ -13,6 +13,7 @@ pub mod draft;
 pub mod gouge;
 pub mod isfc;
 pub mod isoparametric;
+pub mod isoplanar;
 pub mod options;
 pub mod order;
 pub mod pipeline;
@@ -38,6 +39,7 @@ pub fn plan(
         Strategy::Isfc => isfc::plan(model, opts, progress),
         Strategy::Watershed => watershed::plan(model, opts, progress, true),
         Strategy::MultiRectangle => watershed::plan(model, opts, progress, false),
+        Strategy::Isoplanar => isoplanar::plan(model, opts, progress),
     }
 }
 pub use pipeline::Planned;

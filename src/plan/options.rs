@@ -68,6 +68,16 @@ pub struct PlanOptions {
     /// `isfc` only: weight of the tool-axis change in a link's cost (eq. 9, per unit of
     /// `‖ΔV‖`). Default 1.
     pub isfc_axis_weight: f64,
+    /// `isoplanar` only: direction of the slicing planes' normal in the XY plane (degrees
+    /// from +X). Default 0°: planes parallel to YZ, passes running roughly along Y.
+    pub slice_angle_deg: f64,
+    /// `isoplanar` only: deform the CL surface so that constant plane spacing leaves
+    /// near-constant scallop (Yuan & Shao 2012). Default true; false: the constant-spacing
+    /// baseline, planes `2 sqrt(2 r h − h²)` apart in plan view.
+    pub isoplanar_deform: bool,
+    /// `isoplanar` only: the paper's shear form of the deformation ratio (eq. 9) instead of
+    /// the exact plane form. Default false.
+    pub isoplanar_shear: bool,
 }
 
 /// The strategies: what to cut, in which order. The shared pipeline decides how.
@@ -87,15 +97,19 @@ pub enum Strategy {
     /// all cut in one direction.
     #[serde(rename = "multi-rectangle")]
     MultiRectangle,
+    /// Iso-planar slicing of the deformed CL surface (Yuan & Shao 2012): parallel planes,
+    /// denser where the surface is steep or concave.
+    Isoplanar,
 }
 
 impl Strategy {
     /// Every strategy, in the order the CLI and the page list them.
-    pub const ALL: [Strategy; 4] = [
+    pub const ALL: [Strategy; 5] = [
         Strategy::Isoparametric,
         Strategy::Isfc,
         Strategy::Watershed,
         Strategy::MultiRectangle,
+        Strategy::Isoplanar,
     ];
 
     /// Its name in options, the CLI and the report.
@@ -105,6 +119,7 @@ impl Strategy {
             Strategy::Isfc => "isfc",
             Strategy::Watershed => "watershed",
             Strategy::MultiRectangle => "multi-rectangle",
+            Strategy::Isoplanar => "isoplanar",
         }
     }
 
@@ -150,6 +165,9 @@ impl Default for PlanOptions {
             isfc_plain: false,
             isfc_length_weight: 1.0,
             isfc_axis_weight: 1.0,
+            slice_angle_deg: 0.0,
+            isoplanar_deform: true,
+            isoplanar_shear: false,
         }
     }
 }
@@ -306,6 +324,15 @@ impl PlanOptions {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::param(name, format!("must be a number ≥ 0, got {v}")));
             }
+        }
+        if !(self.slice_angle_deg.is_finite() && self.slice_angle_deg.abs() <= 360.0) {
+            return Err(Error::param(
+                "slice_angle_deg",
+                format!(
+                    "must be between -360° and 360°, got {}",
+                    self.slice_angle_deg
+                ),
+            ));
         }
         if self.isfc_length_weight + self.isfc_axis_weight <= 0.0 {
             return Err(Error::param(

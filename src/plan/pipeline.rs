@@ -63,6 +63,8 @@ pub struct Planned {
     pub layout: Option<crate::layout::PatchLayout>,
     /// The watershed strategies' regions and rectangles.
     pub watershed: Option<super::watershed::plan::WatershedStats>,
+    /// What the slices are made of (`isoplanar` only).
+    pub isoplanar: Option<super::isoplanar::IsoplanarStats>,
 }
 
 /// Plans with a strategy: `draft` makes its draft, reporting on the first `draft_share` of
@@ -196,6 +198,7 @@ pub fn finish(
     progress(1.0);
     Ok(Planned {
         isfc: draft.isfc,
+        isoplanar: draft.isoplanar,
         isfc_layer: None,
         layout: None,
         watershed: None,
@@ -351,10 +354,31 @@ impl Planned {
                 ));
             }
         }
+        if let Some(s) = &self.isoplanar {
+            r.planes = Some(s.planes);
+            r.segments = Some(s.segments);
+            r.slice_spacing_mm = Some(s.slice_spacing_mm);
+            r.notes.push(format!(
+                "iso-planar: {} planes ({} added where the cusp needed a pass between), normal at {}° from +X in XY, {} mm apart in the {} space; {} pieces, {} joined on the surface, {} with a retraction; deformation ratio up to {:.2} over {} slabs of {:.3} mm",
+                s.planes,
+                s.added_planes,
+                s.slice_angle_deg,
+                fmt_mm(s.slice_spacing_mm),
+                if s.deformed { "deformed" } else { "plan-view (constant-spacing baseline)" },
+                s.segments,
+                s.links,
+                s.retractions,
+                s.max_ratio,
+                s.slabs,
+                s.slab_mm
+            ));
+        }
         if self.forced_retractions > 0 {
             r.notes.push(format!(
                 "{}: {} retraction(s) used",
-                if self.isfc.is_some() {
+                if self.isoplanar.is_some() {
+                    "pieces of the slices too far apart to join on the surface"
+                } else if self.isfc.is_some() {
                     "the layout falls into parts no curve can join across a shared side"
                 } else {
                     "no patch order and transit corners avoid retractions on this layout"
@@ -545,4 +569,9 @@ impl PlanReport {
         }
         self.status = PlanStatus::of(&self.problems);
     }
+}
+
+/// A length for a note: four decimals (mm).
+fn fmt_mm(mm: f64) -> String {
+    format!("{mm:.4}")
 }

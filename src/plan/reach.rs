@@ -993,6 +993,7 @@ mod tests {
             safe_z: 10.0,
             forced_retractions: 0,
             isfc: None,
+            isoplanar: None,
         };
         let mut skip = vec![None; n];
         skip[4] = Some(Why::ToolHits);

@@ -146,6 +146,15 @@ pub struct PlanReport {
     /// direction it is cut in and its passes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rectangles: Option<Vec<RectangleReport>>,
+    /// `isoplanar`: slicing planes with a pass (of them added where the cusp needed one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub planes: Option<usize>,
+    /// `isoplanar`: connected pieces of the slices cut.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segments: Option<usize>,
+    /// `isoplanar`: spacing of the planes in the deformed space (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slice_spacing_mm: Option<f64>,
 }
 
 /// One rectangle of a watershed plan.
@@ -289,6 +298,9 @@ impl Toolpath {
             compensated_corners: None,
             regions: None,
             rectangles: None,
+            planes: None,
+            segments: None,
+            slice_spacing_mm: None,
         };
         let mut patches: Vec<u32> = self.moves.iter().map(|m| m.patch).collect();
         patches.sort_unstable();

@@ -358,7 +358,7 @@ const SIDE_MATCH_REL: f64 = 1e-6;
 /// 1: `u = 1`, 2: `v = 1`, 3: `u = 0`): the layout's side connections, and sides that lie on
 /// each other in space although the layout has a strip of zero width between them (a
 /// crease's repeated knots), wholly or in part.
-fn shared_sides(model: &Model, views: &[PatchView]) -> Vec<(u32, u8, u32, u8)> {
+pub(crate) fn shared_sides(model: &Model, views: &[PatchView]) -> Vec<(u32, u8, u32, u8)> {
     let mut out: Vec<(u32, u8, u32, u8)> = model
         .layout
         .connections

@@ -1,0 +1,1167 @@
+//! Iso-planar slicing with CL-surface deformation (Yuan & Shao 2012): parallel planes, the
+//! cut every shop knows, spaced so that the scallop stays near the limit on steep and
+//! concave areas too.
+//!
+//! The ball-centre (CL) surface is meshed from the exact limit surface ([`clmesh`]), seen
+//! from above as a height grid and deformed along the planes' normal so that constant
+//! spacing in the deformed space means the spacing the scallop allows in the original
+//! ([`deform`]); the deformed mesh is sliced by planes at the flat-floor spacing `d_w`
+//! ([`slice`]), every slice point kept as the mesh edge and parameter it lies at, so that
+//! it maps back exactly; its contact point is then evaluated on the surface at that
+//! parameter. Pieces of a slice meeting at a patch seam are joined; the pieces are cut in a
+//! zig-zag over the planes, joined on the surface where the next one starts close by,
+//! else with a retraction. With [`PlanOptions::isoplanar_deform`] off the planes are
+//! spaced `d_w` apart in plan view (the constant-spacing baseline). Where the cusp
+//! predicted between neighbouring passes (eq. 5 from the contact points' distance and the
+//! curvature across) would exceed the scallop, a pass half-way between is added over that
+//! stretch (`added_passes`), up to [`MAX_SPLITS`] times.
+//!
+//! The shared pipeline does the rest: tool axes (the project's collision-free axis, or the
+//! paper's normal with [`PlanOptions::lead_deg`]), lifting balls clear of creases and
+//! concave spots tighter than the ball, air moves, what cannot be reached.
+//!
+//! Owns: the slices and their order. Must not: choose tool axes or route air moves.
+
+pub mod clmesh;
+pub mod deform;
+pub mod slice;
+
+use self::clmesh::ClMesh;
+use self::deform::{Deformation, Frame, RatioForm};
+use super::draft::{Draft, DraftBuilder, Footprint, SurfacePoint};
+use super::pipeline::Planned;
+use super::stepover;
+use super::PlanOptions;
+use crate::error::{Error, Result};
+use crate::geom::{Point3, Vector3};
+use crate::model::Model;
+use crate::surface::DiffGeom;
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+
+/// Share of the scallop reserved for the material the straight moves leave over concave
+/// stretches (as the other planners reserve it).
+const CHORD_SCALLOP_SHARE: f64 = 0.15;
+/// Most slabs of `x` the deformation ratio is taken over.
+const MAX_SLABS: usize = 4096;
+/// Narrowest slab, as a share of the flat-floor slice spacing.
+const SLAB_SHARE: f64 = 0.25;
+/// Pass points closer than this share of the slice spacing to the last one checked are not
+/// checked for the cusp beside them (their neighbours' cusps stand for theirs).
+const CHECK_EVERY_SHARE: f64 = 0.25;
+/// How far the neighbouring pass is looked for, in flat-floor spacings.
+const CHECK_REACH_SPACINGS: f64 = 3.0;
+/// Most halvings of a stretch between two slice points while meeting the chordal tolerance.
+const CHORD_DEPTH: usize = 12;
+/// Slice ends at patch seams closer than this share of the slice spacing are joined.
+const SEAM_SHARE: f64 = 0.5;
+/// Pieces are joined on the surface (a link) when the next starts within this many slice
+/// spacings of where the last ended, on the same patch; else the tool retracts.
+const LINK_SPACINGS: f64 = 3.0;
+/// Cosine of the angle from square to the feed within which a neighbouring pass counts as
+/// beside a point (60°).
+const BESIDE_COS: f64 = 0.5;
+/// Most times the planes between two neighbours are halved where the predicted cusp is
+/// over the scallop.
+pub const MAX_SPLITS: usize = 3;
+/// Patch corners closer than this share of the model's diagonal are the same point.
+const BOUNDARY_JOIN_REL: f64 = 1e-7;
+/// Share of the overcut a thinned chord may leave at the slice points it passes over: the
+/// points lie only a few per chord, and midway between them the chord dips further
+/// (keycap-concave, r 0.5 mm, h 0.005 mm: 0.0027 mm cut in with the whole 0.002 mm allowed
+/// at the points, 0.0016 mm with half).
+const THIN_SHARE: f64 = 0.5;
+/// Most slice points one chord may stand for when thinning.
+const THIN_LOOKAHEAD: usize = 64;
+/// Share of the progress bar the slicing takes (the pipeline the rest).
+const DRAFT_SHARE: f64 = 0.5;
+
+/// What the iso-planar plan is made of, for the report.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct IsoplanarStats {
+    /// Planes with at least one pass (of them added where the cusp needed it).
+    pub planes: usize,
+    pub added_planes: usize,
+    /// Connected pieces of the slices cut (a plane may cut the surface in several), the
+    /// passes along the boundary included.
+    pub segments: usize,
+    /// Passes along the surface's free boundary (one per loop or open stretch).
+    pub boundary_passes: usize,
+    /// Spacing of the planes in the deformed space (mm): `d_w`.
+    pub slice_spacing_mm: f64,
+    /// The planes' normal in the XY plane (degrees from +X).
+    pub slice_angle_deg: f64,
+    /// Whether the CL surface was deformed (false: the constant-spacing baseline).
+    pub deformed: bool,
+    /// Largest deformation ratio.
+    pub max_ratio: f64,
+    /// Slabs of `x` the ratio is taken over, and their width (mm).
+    pub slabs: usize,
+    pub slab_mm: f64,
+    /// Triangles of the CL mesh.
+    pub mesh_triangles: usize,
+    /// Joins between pieces on the surface, and retractions between them.
+    pub links: usize,
+    pub retractions: usize,
+    /// Largest scallop eq. 5 predicts between neighbouring passes (mm).
+    pub max_predicted_scallop_mm: f64,
+}
+
+/// A point of a slice: where on the CL mesh (the edge and parameter), its patch parameters,
+/// and its place in the deformed frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlicePoint {
+    pub hit: slice::Hit,
+    pub patch: u32,
+    pub uv: [f64; 2],
+    /// The point of the CL mesh (mm).
+    pub mesh_cl: Point3,
+    /// `(x', y, z)` in the deformed slicing frame (mm): `x'` is the plane's value.
+    pub deformed: [f64; 3],
+}
+
+/// A connected piece of one plane's slice.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pass {
+    /// The plane's `x'` (mm).
+    pub plane: f64,
+    pub points: Vec<SlicePoint>,
+    pub closed: bool,
+    /// Added between two planes where the cusp needed it.
+    pub added: bool,
+}
+
+/// The slices before they become moves.
+#[derive(Debug, Clone)]
+pub struct Slices {
+    pub mesh: ClMesh,
+    pub frame: Frame,
+    pub deformation: Deformation,
+    /// `x'` of every mesh vertex (mm; NaN at vertices the mesh lacks).
+    pub x_prime: Vec<f64>,
+    pub passes: Vec<Pass>,
+    pub stats: IsoplanarStats,
+}
+
+/// Plans `model` with iso-planar passes and hands them to the shared pipeline. `progress`
+/// receives the fraction done and returns `false` to cancel.
+pub fn plan(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<Planned> {
+    super::pipeline::plan_with(model, opts, progress, DRAFT_SHARE, |p| {
+        draft(model, opts, p)
+    })
+}
+
+/// The scallop the planes are spaced for: the request less the chords' share, and eq. 5's
+/// small-h form made exact (it runs low by about h / 2r).
+fn side_scallop(opts: &PlanOptions) -> f64 {
+    let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
+    h / (1.0 + h / (2.0 * opts.tool_radius_mm))
+}
+
+/// Tool-side fundamental forms of `model` at patch `patch`, `uv`.
+fn geometry(model: &Model, patch: u32, uv: [f64; 2]) -> Option<DiffGeom> {
+    let p = &model.layout.patches[patch as usize];
+    let g = DiffGeom::try_from_derivs(&p.derivs(&model.surface, uv[0], uv[1]))?;
+    Some(if model.tool_side() < 0.0 {
+        g.flipped()
+    } else {
+        g
+    })
+}
+
+/// Normal curvature of `g` in the tangent direction closest to `dir` (1/mm).
+fn curvature_along(g: &DiffGeom, dir: &Vector3, su: &Vector3, sv: &Vector3) -> f64 {
+    // (du, dv) with S_u du + S_v dv the tangent projection of dir: the metric's inverse.
+    let (a, b) = (su.dot(dir), sv.dot(dir));
+    let det = g.e * g.g - g.f * g.f;
+    if !(det > 0.0) {
+        return 0.0;
+    }
+    let (du, dv) = ((g.g * a - g.f * b) / det, (g.e * b - g.f * a) / det);
+    if du == 0.0 && dv == 0.0 {
+        return 0.0;
+    }
+    g.normal_curvature(du, dv)
+}
+
+/// The feed direction on the surface along a plane with normal `x` (unit tangent of the
+/// plane's cut), and the direction across it, at a point with unit normal `n`; `None`
+/// where the surface faces along `x` (the plane is tangent).
+fn feed_frame(n: &Vector3, x: &Vector3) -> Option<(Vector3, Vector3)> {
+    let t = n.cross(x).try_normalize(1e-9)?;
+    let c = t.cross(n);
+    Some((t, c))
+}
+
+/// The slices of `model`: the CL mesh, its deformation, and every plane's passes, with the
+/// passes added where the cusp needed them. `progress` receives the fraction done.
+pub fn slices(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<Slices> {
+    opts.validate()?;
+    if model.layout.is_empty() {
+        return Err(Error::InvalidMesh(
+            "the model has no patches to machine".into(),
+        ));
+    }
+    let r = opts.tool_radius_mm;
+    let h = side_scallop(opts);
+    let spacing = deform::flat_spacing(r, h);
+    let mesh = ClMesh::new(model, r, opts.chordal_mm)?;
+    if !progress(0.2) {
+        return Err(Error::Cancelled);
+    }
+    let frame = Frame::new(opts.slice_angle_deg);
+    let coords: Vec<[f64; 3]> = mesh
+        .vertices
+        .iter()
+        .map(|v| v.map_or([f64::NAN; 3], |v| frame.coords(&v.cl)))
+        .collect();
+    let (mut x_lo, mut x_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for c in coords.iter().filter(|c| c[0].is_finite()) {
+        x_lo = x_lo.min(c[0]);
+        x_hi = x_hi.max(c[0]);
+    }
+    let deformation = if opts.isoplanar_deform {
+        let form = if opts.isoplanar_shear {
+            RatioForm::Shear
+        } else {
+            RatioForm::ExactPlane
+        };
+        // The ratio at every vertex of the mesh, from its exact normal and the curvature
+        // across the plane through it.
+        let mut points = Vec::with_capacity(mesh.vertices.len());
+        for (v, c) in mesh.vertices.iter().zip(&coords) {
+            let Some(v) = v else { continue };
+            let Some(g) = geometry(model, v.patch, v.uv) else {
+                continue;
+            };
+            let n = [g.normal.dot(&frame.x), g.normal.dot(&frame.y), g.normal.z];
+            // Slopes of the CL surface (its normal is the design surface's at the contact),
+            // from +Z or, on an underside, from −Z: the plane spacing depends only on how
+            // steeply the surface climbs in x.
+            let (p, q) = if n[2].abs() > 0.0 {
+                (-n[0] / n[2], -n[1] / n[2])
+            } else {
+                (f64::INFINITY, 0.0)
+            };
+            let patch = &model.layout.patches[v.patch as usize];
+            let d = patch.derivs(&model.surface, v.uv[0], v.uv[1]);
+            let (kx, ky) = match feed_frame(&g.normal, &frame.x) {
+                Some((t, across)) => (
+                    curvature_along(&g, &across, &d.su, &d.sv),
+                    curvature_along(&g, &t, &d.su, &d.sv),
+                ),
+                None => (0.0, 0.0),
+            };
+            points.push((c[0], deform::ratio(form, p, q, r, kx, ky)));
+        }
+        Deformation::new(&points, x_lo, x_hi, SLAB_SHARE * spacing, MAX_SLABS)
+    } else {
+        Deformation::identity(x_lo, x_hi)
+    };
+    if !progress(0.4) {
+        return Err(Error::Cancelled);
+    }
+    let seam = SEAM_SHARE * spacing;
+    let x_prime: Vec<f64> = coords
+        .iter()
+        .map(|c| {
+            if c[0].is_finite() {
+                deformation.at(c[0])
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    let (mut passes, step) = slice_all(&mesh, &frame, &x_prime, spacing, seam);
+    if !progress(0.6) {
+        return Err(Error::Cancelled);
+    }
+    let tri_range: Vec<(f64, f64)> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let f = t.map(|v| x_prime[v as usize]);
+            (f[0].min(f[1]).min(f[2]), f[0].max(f[1]).max(f[2]))
+        })
+        .collect();
+    let tris_at = |c: f64| -> Vec<u32> {
+        tri_range
+            .iter()
+            .enumerate()
+            .filter(|(_, &(a, b))| a < c && b >= c)
+            .map(|(i, _)| i as u32)
+            .collect()
+    };
+    let cut = |c: f64, tris: &[u32]| cut_plane(&mesh, &frame, &x_prime, c, tris, seam);
+    // What is still too wide: passes added half-way between neighbours over that stretch.
+    passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
+    let mut added_planes = 0;
+    let mut gap = step;
+    let mut predicted: f64 = 0.0;
+    for round in 0..=MAX_SPLITS {
+        let (needs, worst) = too_wide(model, opts, &frame, &passes, gap);
+        predicted = predicted.max(worst);
+        if needs.is_empty() {
+            break;
+        }
+        if round == MAX_SPLITS {
+            // Left as it is: the report says the predicted scallop is over.
+            predicted = predicted.max(needs.iter().map(|n| n.2).fold(0.0, f64::max));
+            break;
+        }
+        gap *= 0.5;
+        for (c, near, _) in needs {
+            let tris = tris_at(c);
+            let near: Vec<Point3> = near.into_iter().map(|n| n.0).collect();
+            let mut kept: Vec<Pass> = Vec::new();
+            for p in cut(c, &tris) {
+                kept.extend(keep_near(p, &near, LINK_SPACINGS * spacing));
+            }
+            if !kept.is_empty() {
+                added_planes += 1;
+            }
+            passes.extend(kept);
+        }
+        passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
+    }
+    passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
+    let planes = {
+        let mut v: Vec<f64> = passes.iter().map(|p| p.plane).collect();
+        v.dedup();
+        v.len()
+    };
+    // Last, a pass along the surface's free boundary: where a boundary runs slanted to the
+    // planes, or curves, the last pass of a plane ends short of it.
+    let boundary = boundary_passes(model, &mesh);
+    let boundary_passes = boundary.len();
+    passes.extend(boundary);
+    let max_ratio = deformation.ratio.iter().copied().fold(1.0, f64::max);
+    let stats = IsoplanarStats {
+        planes,
+        added_planes,
+        boundary_passes,
+        segments: passes.len(),
+        slice_spacing_mm: step,
+        slice_angle_deg: opts.slice_angle_deg,
+        deformed: opts.isoplanar_deform,
+        max_ratio,
+        slabs: deformation.ratio.len(),
+        slab_mm: deformation.step,
+        mesh_triangles: mesh.triangles.len(),
+        links: 0,
+        retractions: 0,
+        max_predicted_scallop_mm: predicted,
+    };
+    Ok(Slices {
+        mesh,
+        frame,
+        deformation,
+        x_prime,
+        passes,
+        stats,
+    })
+}
+
+/// The passes of every plane over the mesh whose vertices have deformed coordinate
+/// `x_prime`: planes evenly over its extent, at most `spacing` apart, the first and last
+/// half a spacing in; and their spacing (mm).
+fn slice_all(
+    mesh: &ClMesh,
+    frame: &Frame,
+    x_prime: &[f64],
+    spacing: f64,
+    seam: f64,
+) -> (Vec<Pass>, f64) {
+    let (mut f_lo, mut f_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let tri_range: Vec<(f64, f64)> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let f = t.map(|v| x_prime[v as usize]);
+            let (lo, hi) = (f[0].min(f[1]).min(f[2]), f[0].max(f[1]).max(f[2]));
+            f_lo = f_lo.min(lo);
+            f_hi = f_hi.max(hi);
+            (lo, hi)
+        })
+        .collect();
+    let n_planes = ((f_hi - f_lo) / spacing).ceil().max(1.0) as usize;
+    let step = (f_hi - f_lo) / n_planes as f64;
+    let first = f_lo + 0.5 * step;
+    // Triangles per plane: those whose range of x' holds it.
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); n_planes];
+    for (i, &(a, b)) in tri_range.iter().enumerate() {
+        let k0 = ((a - first) / step).ceil().max(0.0) as usize;
+        let k1 = ((b - first) / step).floor();
+        if k1 < 0.0 {
+            continue;
+        }
+        for bucket in buckets.iter_mut().take(k1 as usize + 1).skip(k0) {
+            bucket.push(i as u32);
+        }
+    }
+    let passes = buckets
+        .iter()
+        .enumerate()
+        .flat_map(|(k, tris)| cut_plane(mesh, frame, x_prime, first + k as f64 * step, tris, seam))
+        .collect();
+    (passes, step)
+}
+
+/// The passes of plane `x' = c` over `tris`, joined at patch seams.
+fn cut_plane(
+    mesh: &ClMesh,
+    frame: &Frame,
+    x_prime: &[f64],
+    c: f64,
+    tris: &[u32],
+    seam: f64,
+) -> Vec<Pass> {
+    let chains = slice::slice(&mesh.triangles, tris, x_prime, c);
+    let passes: Vec<Pass> = chains
+        .into_iter()
+        .map(|ch| Pass {
+            plane: c,
+            points: ch
+                .hits
+                .iter()
+                .map(|h| slice_point(mesh, frame, c, *h))
+                .collect(),
+            closed: ch.closed,
+            added: false,
+        })
+        .collect();
+    join_at_seams(mesh, passes, seam)
+}
+
+/// Passes along the free sides of the layout's patches (sides no other patch shares),
+/// through the CL mesh's vertices on them, joined where sides meet into loops round the
+/// boundary and its holes; `plane` is +∞ (they are cut after the planes).
+fn boundary_passes(model: &Model, mesh: &ClMesh) -> Vec<Pass> {
+    let views = super::isoparametric::patch_views(model);
+    let shared = super::isfc::shared_sides(model, &views);
+    let mut passes: Vec<Pass> = Vec::new();
+    for (p, &(first, [nu, nv])) in mesh.patches.iter().enumerate() {
+        for side in 0..4u8 {
+            if shared.iter().any(|&(a, sa, b, sb)| {
+                (a as usize, sa) == (p, side) || (b as usize, sb) == (p, side)
+            }) {
+                continue;
+            }
+            let ij: Vec<(usize, usize)> = match side {
+                0 => (0..=nu).map(|i| (i, 0)).collect(),
+                1 => (0..=nv).map(|j| (nu, j)).collect(),
+                2 => (0..=nu).rev().map(|i| (i, nv)).collect(),
+                _ => (0..=nv).rev().map(|j| (0, j)).collect(),
+            };
+            let points: Vec<SlicePoint> = ij
+                .into_iter()
+                .filter_map(|(i, j)| {
+                    let id = first + (j * (nu + 1) + i) as u32;
+                    let v = mesh.vertices[id as usize]?;
+                    Some(SlicePoint {
+                        hit: slice::Hit {
+                            a: id,
+                            b: id,
+                            t: 0.0,
+                        },
+                        patch: p as u32,
+                        uv: v.uv,
+                        mesh_cl: v.cl,
+                        deformed: [f64::INFINITY, 0.0, 0.0],
+                    })
+                })
+                .collect();
+            if points.len() >= 2 {
+                passes.push(Pass {
+                    plane: f64::INFINITY,
+                    points,
+                    closed: false,
+                    added: false,
+                });
+            }
+        }
+    }
+    // Join sides whose ends meet (patch corners: the same point, up to rounding).
+    let bbox = model.surface.bbox();
+    let tol = BOUNDARY_JOIN_REL * bbox.diagonal().max(1.0);
+    let mut out: Vec<Pass> = Vec::new();
+    while let Some(mut cur) = passes.pop() {
+        loop {
+            let tail = cur.points.last().expect("points").mesh_cl;
+            let head = cur.points[0].mesh_cl;
+            if cur.points.len() > 2 && (tail - head).norm() <= tol {
+                cur.points.pop();
+                cur.closed = true;
+                break;
+            }
+            let next = passes.iter().enumerate().find_map(|(k, q)| {
+                let (a, b) = (
+                    q.points[0].mesh_cl,
+                    q.points.last().expect("points").mesh_cl,
+                );
+                if (a - tail).norm() <= tol {
+                    Some((k, false))
+                } else if (b - tail).norm() <= tol {
+                    Some((k, true))
+                } else {
+                    None
+                }
+            });
+            let Some((k, rev)) = next else { break };
+            let mut q = passes.swap_remove(k);
+            if rev {
+                q.points.reverse();
+            }
+            cur.points.extend(q.points.into_iter().skip(1));
+        }
+        out.push(cur);
+    }
+    out
+}
+
+/// The slice point of `hit` on plane `c`.
+fn slice_point(mesh: &ClMesh, frame: &Frame, c: f64, hit: slice::Hit) -> SlicePoint {
+    let (a, b) = (mesh.vertex(hit.a), mesh.vertex(hit.b));
+    let t = hit.t;
+    let lerp = |x: f64, y: f64| x + (y - x) * t;
+    let mesh_cl = Point3::from(a.cl.coords + (b.cl.coords - a.cl.coords) * t);
+    let f = frame.coords(&mesh_cl);
+    SlicePoint {
+        hit,
+        patch: a.patch,
+        uv: [lerp(a.uv[0], b.uv[0]), lerp(a.uv[1], b.uv[1])],
+        mesh_cl,
+        deformed: [c, f[1], f[2]],
+    }
+}
+
+/// True if mesh edge `(a, b)` lies on its patch grid's boundary.
+fn on_patch_side(mesh: &ClMesh, p: &SlicePoint) -> bool {
+    let (first, [nu, nv]) = mesh.patches[p.patch as usize];
+    let ij = |v: u32| {
+        let k = (v - first) as usize;
+        (k % (nu + 1), k / (nu + 1))
+    };
+    let ((ia, ja), (ib, jb)) = (ij(p.hit.a), ij(p.hit.b));
+    (ia == ib && (ia == 0 || ia == nu)) || (ja == jb && (ja == 0 || ja == nv))
+}
+
+/// Joins open passes of one plane whose ends meet at a patch seam (within `tol` mm), into
+/// longer passes (a pass whose ends meet becomes closed).
+fn join_at_seams(mesh: &ClMesh, mut passes: Vec<Pass>, tol: f64) -> Vec<Pass> {
+    loop {
+        let mut best: Option<(f64, usize, bool, usize, bool)> = None;
+        for i in 0..passes.len() {
+            if passes[i].closed {
+                continue;
+            }
+            for j in i..passes.len() {
+                if passes[j].closed {
+                    continue;
+                }
+                // End of i (tail or head) to end of j.
+                for (ei, ej) in [(true, false), (true, true), (false, false), (false, true)] {
+                    if i == j && ei == ej {
+                        continue;
+                    }
+                    let end = |p: &Pass, tail: bool| {
+                        if tail {
+                            *p.points.last().expect("a pass has points")
+                        } else {
+                            p.points[0]
+                        }
+                    };
+                    let (a, b) = (end(&passes[i], ei), end(&passes[j], ej));
+                    if i == j && passes[i].points.len() < 3 {
+                        continue;
+                    }
+                    if !on_patch_side(mesh, &a) || !on_patch_side(mesh, &b) {
+                        continue;
+                    }
+                    if i != j && a.patch == b.patch {
+                        continue;
+                    }
+                    let d = (a.mesh_cl - b.mesh_cl).norm();
+                    if d <= tol && best.is_none_or(|x| d < x.0) {
+                        best = Some((d, i, ei, j, ej));
+                    }
+                }
+            }
+        }
+        let Some((_, i, ei, j, ej)) = best else {
+            return passes;
+        };
+        if i == j {
+            passes[i].closed = true;
+            continue;
+        }
+        // Orient i to end at the join and j to start there, then append.
+        let mut b = passes.swap_remove(j);
+        let a = &mut passes[i];
+        if !ei {
+            a.points.reverse();
+        }
+        if ej {
+            b.points.reverse();
+        }
+        a.points.extend(b.points);
+    }
+}
+
+/// Planes to add half-way between neighbours `gap` (mm, deformed) apart, with the CL points
+/// near which the cusp eq. 5 predicts from the contact points' distance to the other pass
+/// and the curvature across the feed is over the scallop, and the largest predicted there;
+/// and the largest predicted where it is not over.
+#[allow(clippy::type_complexity)]
+fn too_wide(
+    model: &Model,
+    opts: &PlanOptions,
+    frame: &Frame,
+    passes: &[Pass],
+    gap: f64,
+) -> (Vec<(f64, Vec<(Point3, f64)>, f64)>, f64) {
+    let r = opts.tool_radius_mm;
+    let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
+    // Per plane: every pass point's contact point, CL point and curvature across the feed,
+    // and the pieces' contact polylines.
+    struct Plane {
+        c: f64,
+        points: Vec<(Point3, Point3, f64, Vector3)>,
+        segments: Vec<(Point3, Point3)>,
+    }
+    let mut planes: Vec<Plane> = Vec::new();
+    for p in passes {
+        if planes.last().is_none_or(|x| x.c != p.plane) {
+            planes.push(Plane {
+                c: p.plane,
+                points: Vec::new(),
+                segments: Vec::new(),
+            });
+        }
+        let plane = planes.last_mut().expect("pushed");
+        let (mut last, mut last_cc): (Option<Point3>, Option<Point3>) = (None, None);
+        let every = CHECK_EVERY_SHARE * (8.0 * r * h).sqrt();
+        let n = p.points.len();
+        for (i, s) in p.points.iter().enumerate() {
+            // Every point a quarter spacing on from the last checked, and the last.
+            if last.is_some_and(|l| (s.mesh_cl - l).norm() < every) && i + 1 < n {
+                continue;
+            }
+            let patch = &model.layout.patches[s.patch as usize];
+            let d = patch.derivs(&model.surface, s.uv[0], s.uv[1]);
+            let Some(g) = geometry(model, s.patch, s.uv) else {
+                continue;
+            };
+            // The pass's own direction here (it turns away from the plane's where the
+            // deformation changes across rows), and the curvature across it.
+            let (before, after) = (
+                p.points.get(i.wrapping_sub(1)).unwrap_or(s),
+                p.points.get(i + 1).unwrap_or(s),
+            );
+            let along = after.mesh_cl - before.mesh_cl;
+            let along = along - g.normal * along.dot(&g.normal);
+            let Some(t) = along
+                .try_normalize(1e-12)
+                .or_else(|| feed_frame(&g.normal, &frame.x).map(|f| f.0))
+            else {
+                continue;
+            };
+            let c = g.normal.cross(&t);
+            let kappa = curvature_along(&g, &c, &d.su, &d.sv);
+            plane.points.push((g.point, s.mesh_cl, kappa, t));
+            if let Some(a) = last_cc {
+                plane.segments.push((a, g.point));
+            }
+            last = Some(s.mesh_cl);
+            last_cc = Some(g.point);
+        }
+    }
+    let reach = CHECK_REACH_SPACINGS * (8.0 * r * h).sqrt();
+    let mut out = Vec::new();
+    let mut worst_ok: f64 = 0.0;
+    for w in planes.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if (b.c - a.c - gap).abs() > 1e-6 * gap.max(1.0) {
+            continue;
+        }
+        let (mut near, mut worst) = (Vec::new(), 0.0f64);
+        for (from, to) in [(a, b), (b, a)] {
+            let index = SegmentIndex::new(&to.segments, reach);
+            for &(p, cl, kappa, t) in &from.points {
+                // The neighbouring pass beside the point, not beyond its end (where the
+                // surface ends before the next plane, nothing lies between them).
+                let Some(d) = index.nearest_beside(&p, &t) else {
+                    continue;
+                };
+                let k = kappa.min(stepover::MAX_CONCAVE_RK / r);
+                let predicted = stepover::predicted_scallop(d, r, k);
+                if predicted > h {
+                    near.push((cl, (predicted / h).sqrt()));
+                    worst = worst.max(predicted);
+                } else {
+                    worst_ok = worst_ok.max(predicted);
+                }
+            }
+        }
+        if !near.is_empty() {
+            out.push((0.5 * (a.c + b.c), near, worst));
+        }
+    }
+    (out, worst_ok)
+}
+
+/// Nearest-segment queries among segments within a reach, through a uniform grid of cells
+/// twice the reach: each segment is listed in the cells of the middles of its pieces no
+/// longer than half the reach, so that any of its points within the reach of a query lies
+/// in the query's cell or a neighbour.
+struct SegmentIndex<'a> {
+    segments: &'a [(Point3, Point3)],
+    cell: f64,
+    reach: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl<'a> SegmentIndex<'a> {
+    fn new(segments: &'a [(Point3, Point3)], reach: f64) -> Self {
+        let reach = reach.max(1e-9);
+        let cell = 2.0 * reach;
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (i, (a, b)) in segments.iter().enumerate() {
+            let pieces = ((b - a).norm() / (0.5 * reach)).ceil().max(1.0) as usize;
+            let mut last = None;
+            for k in 0..pieces {
+                let m = a + (b - a) * ((k as f64 + 0.5) / pieces as f64);
+                let key = [m.x, m.y, m.z].map(|x| (x / cell).floor() as i64);
+                if last != Some(key) {
+                    let list = cells.entry(key).or_default();
+                    if list.last() != Some(&(i as u32)) {
+                        list.push(i as u32);
+                    }
+                    last = Some(key);
+                }
+            }
+        }
+        SegmentIndex {
+            segments,
+            cell,
+            reach,
+            cells,
+        }
+    }
+
+    /// Distance (mm) to the nearest segment, if one lies within the reach.
+    fn nearest(&self, q: &Point3) -> Option<f64> {
+        self.nearest_where(q, &|_| true)
+    }
+
+    /// Distance (mm) to the nearest point of a segment within the reach that lies beside
+    /// `q` as seen along the unit direction `t` (within 60° of square to it).
+    fn nearest_beside(&self, q: &Point3, t: &Vector3) -> Option<f64> {
+        self.nearest_where(q, &|v: &Vector3| v.dot(t).abs() <= BESIDE_COS * v.norm())
+    }
+
+    /// Distance (mm) to the nearest point of a segment within the reach whose offset from
+    /// `q` passes `keep`.
+    fn nearest_where(&self, q: &Point3, keep: &dyn Fn(&Vector3) -> bool) -> Option<f64> {
+        let c = [q.x, q.y, q.z].map(|x| (x / self.cell).floor() as i64);
+        let mut best: Option<f64> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(v) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                        continue;
+                    };
+                    // (A segment listed in several neighbouring cells is measured again.)
+                    for &i in v {
+                        let (a, b) = self.segments[i as usize];
+                        let v = nearest_on_segment(q, &a, &b) - q;
+                        let d = v.norm();
+                        if d <= self.reach && keep(&v) && best.is_none_or(|x| d < x) {
+                            best = Some(d);
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The parts of `pass` whose CL points lie within `reach` (mm) of a point of `near`, as
+/// separate open passes.
+fn keep_near(pass: Pass, near: &[Point3], reach: f64) -> Vec<Pass> {
+    let segments: Vec<(Point3, Point3)> = near.iter().map(|&p| (p, p)).collect();
+    let index = SegmentIndex::new(&segments, reach);
+    let mut out = Vec::new();
+    let mut run: Vec<SlicePoint> = Vec::new();
+    for s in &pass.points {
+        if index.nearest(&s.mesh_cl).is_some() {
+            run.push(*s);
+        } else if !run.is_empty() {
+            out.push(std::mem::take(&mut run));
+        }
+    }
+    if !run.is_empty() {
+        out.push(run);
+    }
+    out.into_iter()
+        .filter(|r| r.len() >= 2)
+        .map(|points| Pass {
+            plane: pass.plane,
+            points,
+            closed: false,
+            added: true,
+        })
+        .collect()
+}
+
+/// The passes as a draft for the pipeline.
+pub fn draft(
+    model: &Model,
+    opts: &PlanOptions,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<Draft> {
+    let s = slices(model, opts, &mut |f| progress(0.8 * f))?;
+    let mut stats = s.stats;
+    let r = opts.tool_radius_mm;
+    let spacing = deform::flat_spacing(r, side_scallop(opts));
+    let mut out = DraftBuilder::new(model, opts);
+    let ctx = Emit {
+        model,
+        r,
+        chordal: opts.chordal_mm,
+        overcut: opts.overcut_mm(),
+        leave: CHORD_SCALLOP_SHARE * opts.scallop_mm,
+        side: model.tool_side(),
+        spacing,
+        h: side_scallop(opts),
+    };
+    // Zig-zag: plane by plane, the nearest remaining piece of the plane next.
+    let mut remaining: Vec<Option<&Pass>> = s.passes.iter().map(Some).collect();
+    let mut at: Option<SurfacePoint> = None;
+    let mut line = 0u32;
+    let mut k = 0;
+    while k < remaining.len() {
+        let Some(first) = remaining[k] else {
+            k += 1;
+            continue;
+        };
+        // The pieces of this plane not yet cut: the one starting nearest the tool next.
+        let plane = first.plane;
+        let mut best: Option<(f64, usize, bool)> = None;
+        for (j, p) in remaining.iter().enumerate().skip(k) {
+            let Some(p) = p else { continue };
+            if p.plane != plane {
+                break;
+            }
+            let here = at.map(|a| a.cc);
+            let ends: &[bool] = if p.closed { &[false] } else { &[false, true] };
+            for &rev in ends {
+                let e = if rev {
+                    p.points.last().expect("points")
+                } else {
+                    &p.points[0]
+                };
+                let d = here.map_or(0.0, |h| (e.mesh_cl - h).norm());
+                if best.is_none_or(|b| d < b.0) {
+                    best = Some((d, j, rev));
+                }
+            }
+        }
+        let Some((_, j, rev)) = best else {
+            k += 1;
+            continue;
+        };
+        let pass = remaining[j].take().expect("remaining");
+        let mut pts: Vec<SlicePoint> = pass.points.clone();
+        if rev {
+            pts.reverse();
+        }
+        if pass.closed {
+            // Start a loop where it comes nearest the tool, and close it.
+            if let Some(a) = at {
+                let s0 = (0..pts.len())
+                    .min_by(|&x, &y| {
+                        (pts[x].mesh_cl - a.cc)
+                            .norm()
+                            .total_cmp(&(pts[y].mesh_cl - a.cc).norm())
+                    })
+                    .unwrap_or(0);
+                pts.rotate_left(s0);
+            }
+            pts.push(pts[0]);
+        }
+        let points = ctx.refine(&pts)?;
+        let Some(start) = points.first().copied() else {
+            continue;
+        };
+        let joined = at.is_some_and(|a| ctx.can_link(&a, &start));
+        if joined {
+            ctx.link(&mut out, &at.expect("joined"), &start, line)?;
+            stats.links += 1;
+        } else {
+            if at.is_some() {
+                stats.retractions += 1;
+            }
+            out.approach(&start, line, ctx.footprint(&points, 0));
+        }
+        for i in 1..points.len() {
+            out.feed(&points[i], line, ctx.footprint(&points, i));
+        }
+        at = points.last().copied();
+        line += 1;
+    }
+    if !progress(1.0) {
+        return Err(Error::Cancelled);
+    }
+    let mut d = out.finish(
+        "isoplanar",
+        Vec::new(),
+        stats.max_predicted_scallop_mm,
+        stats.retractions,
+    );
+    d.isoplanar = Some(stats);
+    Ok(d)
+}
+
+/// What placing moves needs.
+struct Emit<'a> {
+    model: &'a Model,
+    r: f64,
+    chordal: f64,
+    overcut: f64,
+    /// Most a ball-centre chord may pass above its curve (mm): the scallop's share for
+    /// chords.
+    leave: f64,
+    side: f64,
+    /// Flat-floor slice spacing (mm).
+    spacing: f64,
+    /// The scallop the planes were spaced for (mm).
+    h: f64,
+}
+
+impl Emit<'_> {
+    /// The surface point of patch `patch` at `uv`.
+    fn point(&self, patch: u32, uv: [f64; 2]) -> Result<SurfacePoint> {
+        let uv = [uv[0].clamp(0.0, 1.0), uv[1].clamp(0.0, 1.0)];
+        let p = &self.model.layout.patches[patch as usize];
+        let (cc, n) = p.point_normal(&self.model.surface, uv[0], uv[1]);
+        let n = n.ok_or_else(|| Error::Degenerate {
+            location: format!("patch {patch} at (u, v) = ({:.6}, {:.6})", uv[0], uv[1]),
+            message: "the surface has no tangent plane here or nearby".into(),
+        })?;
+        Ok(SurfacePoint {
+            patch,
+            uv,
+            cc,
+            normal: n * self.side,
+        })
+    }
+
+    /// The slice's contact points, with points added between neighbours of one patch until
+    /// the chords of the contact and ball-centre curves are within their limits.
+    fn refine(&self, pts: &[SlicePoint]) -> Result<Vec<SurfacePoint>> {
+        let mut out: Vec<SurfacePoint> = Vec::with_capacity(pts.len());
+        let mut prev: Option<(SlicePoint, SurfacePoint)> = None;
+        for s in pts {
+            let p = self.point(s.patch, s.uv)?;
+            if let Some((ps, pp)) = prev {
+                if ps.patch == s.patch {
+                    self.split(s.patch, (ps.uv, &pp), (s.uv, &p), CHORD_DEPTH, &mut out)?;
+                }
+            }
+            // Drop repeats (a slice through a mesh vertex crosses its edges there twice).
+            if out
+                .last()
+                .is_none_or(|q: &SurfacePoint| (q.cc - p.cc).norm() > 1e-9)
+            {
+                out.push(p);
+            }
+            prev = Some((*s, p));
+        }
+        Ok(self.thin(out))
+    }
+
+    /// `points` without those the chords of their neighbours already hold: from each point
+    /// kept, the next kept is the farthest one whose chord passes within the limits of every
+    /// point between (the slice points lie as densely as the mesh's edges, far denser than
+    /// the chordal tolerance asks for on gently curved stretches).
+    fn thin(&self, points: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
+        let n = points.len();
+        if n < 3 {
+            return points;
+        }
+        let holds = |i: usize, j: usize| {
+            let (a, b) = (&points[i], &points[j]);
+            a.patch == b.patch
+                && points[i + 1..j]
+                    .iter()
+                    .all(|m| m.patch == a.patch && self.chord_holds(a, b, m, THIN_SHARE))
+        };
+        let mut keep = vec![0];
+        let mut i = 0;
+        while i + 1 < n {
+            let mut j = i + 1;
+            while j + 1 < n && j + 1 - i <= THIN_LOOKAHEAD && holds(i, j + 1) {
+                j += 1;
+            }
+            keep.push(j);
+            i = j;
+        }
+        keep.into_iter().map(|k| points[k]).collect()
+    }
+
+    /// Adds to `out` the points strictly between `a` and `b` (same patch) that bring the
+    /// chords within the limits.
+    fn split(
+        &self,
+        patch: u32,
+        (ua, pa): ([f64; 2], &SurfacePoint),
+        (ub, pb): ([f64; 2], &SurfacePoint),
+        depth: usize,
+        out: &mut Vec<SurfacePoint>,
+    ) -> Result<()> {
+        if depth == 0 {
+            return Ok(());
+        }
+        let um = [0.5 * (ua[0] + ub[0]), 0.5 * (ua[1] + ub[1])];
+        let pm = self.point(patch, um)?;
+        if self.chord_holds(pa, pb, &pm, 1.0) {
+            return Ok(());
+        }
+        self.split(patch, (ua, pa), (um, &pm), depth - 1, out)?;
+        out.push(pm);
+        self.split(patch, (um, &pm), (ub, pb), depth - 1, out)
+    }
+
+    /// Whether the straight move from `a` to `b` passes within the limits of `m`, a point of
+    /// the curve it replaces: the contact chord within the chordal tolerance, the ball-centre
+    /// chord below the curve (cutting in) by at most `share` of the overcut, above it
+    /// (leaving material, which adds to the scallop) by at most `share` of the scallop's
+    /// share for chords.
+    fn chord_holds(
+        &self,
+        a: &SurfacePoint,
+        b: &SurfacePoint,
+        m: &SurfacePoint,
+        share: f64,
+    ) -> bool {
+        let cl = |p: &SurfacePoint| p.cc + p.normal * self.r;
+        if dist_to_segment(&m.cc, &a.cc, &b.cc) > self.chordal {
+            return false;
+        }
+        let c = cl(m);
+        let off = c - nearest_on_segment(&c, &cl(a), &cl(b));
+        let limit = if off.dot(&m.normal) >= 0.0 {
+            self.overcut
+        } else {
+            self.leave
+        };
+        off.norm() <= share * limit
+    }
+
+    /// Whether the tool may go from `a` to `b` on the surface: the same patch, and close.
+    fn can_link(&self, a: &SurfacePoint, b: &SurfacePoint) -> bool {
+        a.patch == b.patch && (a.cc - b.cc).norm() <= LINK_SPACINGS * self.spacing
+    }
+
+    /// Moves on the surface from `a` to `b` along the straight parameter line, with the
+    /// chordal forward steps.
+    fn link(
+        &self,
+        out: &mut DraftBuilder,
+        a: &SurfacePoint,
+        b: &SurfacePoint,
+        line: u32,
+    ) -> Result<()> {
+        let mut pts = Vec::new();
+        self.split(a.patch, (a.uv, a), (b.uv, b), CHORD_DEPTH, &mut pts)?;
+        for p in &pts {
+            out.link(p, line, Footprint::NONE);
+        }
+        out.link(b, line, Footprint::NONE);
+        Ok(())
+    }
+
+    /// The part of its patch point `i` of a pass stands for: half-way to its neighbours
+    /// along the pass and half a side step across, as a rectangle of patch parameters.
+    fn footprint(&self, pts: &[SurfacePoint], i: usize) -> Footprint {
+        let p = &pts[i];
+        let patch = &self.model.layout.patches[p.patch as usize];
+        let d = patch.derivs(&self.model.surface, p.uv[0], p.uv[1]);
+        let Some(g) = DiffGeom::try_from_derivs(&d) else {
+            return Footprint::NONE;
+        };
+        let same = |j: Option<usize>| j.and_then(|j| pts.get(j)).filter(|q| q.patch == p.patch);
+        let (prev, next) = (same(i.checked_sub(1)), same(Some(i + 1)));
+        let half = |q: Option<&SurfacePoint>| {
+            q.map(|q| [0.5 * (q.uv[0] - p.uv[0]), 0.5 * (q.uv[1] - p.uv[1])])
+        };
+        let (a, b) = match (half(prev), half(next)) {
+            (Some(a), Some(b)) => (a, b),
+            (Some(a), None) => (a, [-a[0], -a[1]]),
+            (None, Some(b)) => ([-b[0], -b[1]], b),
+            (None, None) => ([0.0; 2], [0.0; 2]),
+        };
+        // Across: half the allowed side step, in parameters (the metric's inverse).
+        let along = d.su * (b[0] - a[0]) + d.sv * (b[1] - a[1]);
+        let across = g
+            .normal
+            .cross(&along)
+            .try_normalize(1e-12)
+            .unwrap_or_else(|| d.su.normalize());
+        let step = 0.5 * (8.0 * self.r * self.h).sqrt();
+        let (x, y) = (d.su.dot(&across) * step, d.sv.dot(&across) * step);
+        let det = g.e * g.g - g.f * g.f;
+        let c = if det > 0.0 {
+            [(g.g * x - g.f * y) / det, (g.e * y - g.f * x) / det]
+        } else {
+            [0.0, 0.0]
+        };
+        let mut lo = p.uv;
+        let mut hi = p.uv;
+        for corner in [a, b] {
+            for s in [-1.0, 1.0] {
+                for k in 0..2 {
+                    let v = p.uv[k] + corner[k] + s * c[k];
+                    lo[k] = lo[k].min(v);
+                    hi[k] = hi[k].max(v);
+                }
+            }
+        }
+        Footprint {
+            patch: p.patch,
+            rect: [
+                lo[0].max(0.0),
+                hi[0].min(1.0),
+                lo[1].max(0.0),
+                hi[1].min(1.0),
+            ],
+        }
+    }
+}
+
+/// The point of the segment `a`–`b` nearest `p`.
+fn nearest_on_segment(p: &Point3, a: &Point3, b: &Point3) -> Point3 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a + ab * t
+}
+
+/// Distance from `p` to the segment `a`–`b` (mm).
+fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    (p - nearest_on_segment(p, a, b)).norm()
+}
