@@ -88,6 +88,26 @@ fn bench_plan(c: &mut Criterion) {
             })
         });
     }
+    // Iso-planar slicing (issue 16): the convex keycap at the paper's settings (target
+    // 200 ms), three-axis.
+    let m = samples::load_sample("keycap-convex").unwrap();
+    let mut o = PlanOptions::default()
+        .with_tool_radius(0.5)
+        .with_scallop(0.005)
+        .with_chordal(0.001)
+        .with_strategy(Strategy::Isoplanar);
+    o.max_tilt_deg = 0.0;
+    group.bench_function("keycap-convex whole plan isoplanar", |b| {
+        b.iter(|| {
+            black_box(
+                plan::plan(&m, &o, &mut |_| true)
+                    .unwrap()
+                    .toolpath
+                    .moves
+                    .len(),
+            )
+        })
+    });
     group.finish();
 }
 

@@ -68,6 +68,14 @@ for (const strategy of ['watershed', 'multi-rectangle']) {
   console.log(`plan bumps-hole ${strategy} (r 1 mm, h 0.01 mm): ${report.cl_points} CL points, ${report.rectangles.length} rectangles, ${report.reversals} reversals in ${ms.toFixed(0)} ms${strategy === 'watershed' ? ' (target ≤ 800 ms)' : ''}`);
   m.free();
 }
+// Iso-planar slicing (issue 16): the convex keycap at the paper's settings, three-axis
+// (target 500 ms).
+{
+  const m = wasm.Model.sample('keycap-convex');
+  const { ms, report } = timePlan(m, { ...paper, strategy: 'isoplanar', max_tilt_deg: 0 }, 5);
+  console.log(`plan keycap-convex isoplanar: ${report.cl_points} CL points, ${report.planes} planes in ${ms.toFixed(1)} ms (target ≤ 500 ms)`);
+  m.free();
+}
 // The public .tsm files as a user opens them in the page: load, then plan three-axis.
 const models = fileURLToPath(new URL('../www/models/grapetec/', import.meta.url));
 for (const file of ['simple.tsm', 'mouse.tsm', 'face.tsm', 'fan.tsm', 'Bike.tsm', 'gearbox2-9.tsm']) {

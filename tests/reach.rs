@@ -6,9 +6,8 @@
 
 mod support;
 
-use support::{dense_samples, public_tsm, tool_clearance, SampleGrid};
+use support::{dense_samples, extruded_obj, obj_model, public_tsm, tool_clearance, SampleGrid};
 use tspath::geom::{Point3, Vector3};
-use tspath::io;
 use tspath::machine::{self, Dialect, JobInfo, Units};
 use tspath::model::samples;
 use tspath::plan::{isoparametric, PlanOptions, PlanStatus, Planned};
@@ -45,35 +44,6 @@ fn torus_obj(big: f64, small: f64, m: usize, n: usize) -> String {
         }
     }
     s
-}
-
-/// An open sheet cage from a profile in the XZ plane extruded along Y over `ny` quads of
-/// `dy` mm (boundary edges sharp, corners interpolated, as OBJ cages are read). With
-/// `triangles`, every other quad of the first row is split into two triangles.
-fn extruded_obj(profile: &[(f64, f64)], ny: usize, dy: f64, triangles: bool) -> String {
-    let mut s = String::new();
-    let np = profile.len();
-    for k in 0..=ny {
-        for &(x, z) in profile {
-            s += &format!("v {x} {} {z}\n", k as f64 * dy);
-        }
-    }
-    let id = |i: usize, k: usize| k * np + i + 1;
-    for k in 0..ny {
-        for i in 0..np - 1 {
-            let (a, b, c, d) = (id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1));
-            if triangles && k == 0 && i % 2 == 0 {
-                s += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
-            } else {
-                s += &format!("f {a} {b} {c} {d}\n");
-            }
-        }
-    }
-    s
-}
-
-fn obj_model(text: &str, name: &str) -> Model {
-    io::load(text.as_bytes(), name).unwrap()
 }
 
 /// The program for `planned` on `machine` in `dialect`, read back: for every block with a

@@ -7,12 +7,16 @@
  * settings; `kind`: number | patch | choice | flag (a checkbox: `1` in the URL, or the bare
  * attribute); `default`: value when absent (null = the engine's own default, said by `auto`).
  * `fiveAxis`: only for machines that tilt the tool; `isfcOnly`: only for the space-filling
- * curve.
+ * curve; `isoplanarOnly`: only for iso-planar slicing; `invert`: a flag whose PlanOptions
+ * field is its negation.
  */
 export const PARAMS = [
   // Strategy
-  { key: 'strategy', field: 'strategy', group: 'strategy', label: 'How the surface is cut', kind: 'choice', choices: [['isoparametric', 'Patch by patch (isoparametric)'], ['isfc', 'One continuous pass (space-filling curve)'], ['watershed', 'Feature regions in rectangles (watershed)'], ['multi-rectangle', 'Rectangles, one direction (multi-rectangle)']], default: 'isoparametric' },
+  { key: 'strategy', field: 'strategy', group: 'strategy', label: 'How the surface is cut', kind: 'choice', choices: [['isoparametric', 'Patch by patch (isoparametric)'], ['isfc', 'One continuous pass (space-filling curve)'], ['watershed', 'Feature regions in rectangles (watershed)'], ['multi-rectangle', 'Rectangles, one direction (multi-rectangle)'], ['isoplanar', 'Parallel planes (iso-planar, deformed CL surface)']], default: 'isoparametric' },
   { key: 'isfc-plain', field: 'isfc_plain', group: 'strategy', label: 'Plain curve: the paper\u2019s baseline, without the parity repair and the corner compensation', kind: 'flag', default: false, isfcOnly: true },
+  { key: 'slice-angle', field: 'slice_angle_deg', group: 'strategy', label: 'Slicing planes\u2019 normal, from +X in XY', unit: '°', kind: 'number', min: -360, max: 360, step: 5, default: 0, isoplanarOnly: true },
+  { key: 'no-deform', field: 'isoplanar_deform', group: 'strategy', label: 'Constant plane spacing: the baseline, without the CL-surface deformation', kind: 'flag', default: false, invert: true, isoplanarOnly: true },
+  { key: 'shear', field: 'isoplanar_shear', group: 'strategy', label: 'The paper\u2019s shear form of the deformation ratio (eq. 9, denser)', kind: 'flag', default: false, isoplanarOnly: true },
   { key: 'axis-preset', field: null, group: 'strategy', label: 'Tool axis preset', kind: 'choice', choices: [['', 'none: lead and tilt as set under Tool axis'], ['gan2014', 'Gan et al. 2014: 10\u00b0 lead from the surface normal']], default: '', fiveAxis: true },
   // Tool
   { key: 'tool-radius', field: 'tool_radius_mm', group: 'tool', label: 'Ball-end radius', unit: 'mm', kind: 'number', min: 0.05, max: 25, step: 0.05, default: 0.5 },
@@ -135,7 +139,7 @@ export function flagOn(s) {
 
 /** PlanOptions for the engine from validated values (a three-axis machine keeps +Z; the
  * `gan2014` axis preset sets lead `paperLeadDeg` and tilt 0, as `--axis-preset gan2014`;
- * options of the space-filling curve go only with that strategy). */
+ * options of the space-filling curve and of iso-planar slicing go only with theirs). */
 export function planOptions(values, { fiveAxis, paperLeadDeg = 10 }) {
   const o = {};
   for (const p of PARAMS) {
@@ -143,7 +147,8 @@ export function planOptions(values, { fiveAxis, paperLeadDeg = 10 }) {
     const v = values[p.key];
     if (v === null || v === '' || v === undefined) continue;
     if (p.isfcOnly && values.strategy !== 'isfc') continue;
-    o[p.field] = v;
+    if (p.isoplanarOnly && values.strategy !== 'isoplanar') continue;
+    o[p.field] = p.invert ? !v : v;
   }
   if (fiveAxis && values['axis-preset'] === 'gan2014') {
     o.lead_deg = paperLeadDeg;

@@ -153,6 +153,7 @@ const STRATEGY_NAMES = {
   isfc: 'one continuous pass (space-filling curve)',
   watershed: 'feature regions in rectangles (watershed)',
   'multi-rectangle': 'rectangles, one direction (multi-rectangle)',
+  isoplanar: 'parallel planes (iso-planar)',
 };
 
 /** Statistics rows: id, label, value from (report, verification summary, context); the
@@ -749,11 +750,13 @@ export class TspathPlanner extends HTMLElement {
       el.title = !five ? 'Needs a five-axis machine: a three-axis machine keeps the tool axis at +Z'
         : byPreset ? `Set by the tool axis preset (${this.info?.paperLeadDeg ?? 10}° lead, 0° tilt)` : '';
     }
-    const isfc = this.$('p-strategy').value === 'isfc';
-    for (const p of PARAMS.filter((q) => q.isfcOnly)) {
-      const el = this.$(`p-${p.key}`);
-      el.disabled = !isfc;
-      el.title = isfc ? '' : 'Only for the space-filling curve (one continuous pass)';
+    const strategy = this.$('p-strategy').value;
+    for (const [only, name, what] of [['isfcOnly', 'isfc', 'the space-filling curve (one continuous pass)'], ['isoplanarOnly', 'isoplanar', 'iso-planar slicing (parallel planes)']]) {
+      for (const p of PARAMS.filter((q) => q[only])) {
+        const el = this.$(`p-${p.key}`);
+        el.disabled = strategy !== name;
+        el.title = strategy === name ? '' : `Only for ${what}`;
+      }
     }
     const m = this.machineRotaries?.[this.$('p-machine').value];
     this.$('p-machine').title = m ? m.description : '';
@@ -1144,6 +1147,14 @@ export class TspathPlanner extends HTMLElement {
       rows.splice(at, 0,
         ['regions', 'Feature regions', r.strategy === 'watershed' ? `${int(regions.length)} (${int(convex)} convex, ${int(regions.length - convex)} concave)` : 'none (baseline)', String(regions.length)],
         ['rectangles', 'Rectangles', `${int(r.rectangles.length)}, ${int(r.rectangles.filter((x) => x.crossfeed === 'V').length)} cut along u`, String(r.rectangles.length)]);
+    }
+    if (r.strategy === 'isoplanar' && r.planes !== undefined) {
+      // After the retractions: the planes and the pieces they cut.
+      const at = rows.findIndex((x) => x[0] === 'retractions') + 1;
+      const deformed = p.options.isoplanar_deform !== false;
+      rows.splice(at, 0,
+        ['planes', 'Slicing planes', `${int(r.planes)}, ${mm(r.slice_spacing_mm, 4)} apart ${deformed ? 'in the deformed space' : 'in plan view (baseline)'}`, String(r.planes)],
+        ['segments', 'Pieces cut (boundary passes included)', int(r.segments), String(r.segments)]);
     }
     if (r.strategy === 'isfc' && r.grid) {
       // After the retractions: what the one pass is made of.

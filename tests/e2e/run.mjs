@@ -1071,6 +1071,37 @@ test('isfc with the gan2014 axis preset on a five-axis machine: the CLI\'s --axi
   return `${r.cl_points} CL points, largest axis step ${r.max_axis_step_deg.toFixed(2)}°; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
 });
 
+test('isoplanar: keycap-convex sliced at 30°; the slicing controls only for it; the report from wasm is the CLI\'s, the program the CLI\'s', async (page, url) => {
+  const what = 'keycap-convex isoplanar';
+  await page.goto(`${url}?model=keycap-convex&strategy=isoplanar&slice-angle=30&tool-radius=1&scallop=0.05&${SIM}`);
+  await page.waitForSelector(`${HOST}[data-model="keycap-convex"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
+  const chosen = await page.$eval(HOST, (el) => el.shadowRoot.getElementById('p-strategy').selectedOptions[0].textContent);
+  check(/iso-planar/.test(chosen), `?strategy=isoplanar chooses it: “${chosen}”`);
+  check(!(await page.isDisabled('#p-slice-angle')) && (await page.inputValue('#p-slice-angle')) === '30', 'the slice angle is offered, from the URL');
+  await page.uncheck('#auto');
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  await waitVerified(page);
+  const cli = cliPlan('keycap-convex', { toolRadius: 1, scallop: 0.05, extra: ['--strategy', 'isoplanar', '--slice-angle', '30'] });
+  const r = cli.report;
+  check(r.strategy === 'isoplanar' && r.planes > 10 && r.segments >= r.planes && r.slice_spacing_mm > 0, `${r.planes} planes, ${r.segments} pieces, ${r.slice_spacing_mm} mm apart`);
+  const mine = await host(page, (el) => el.plan.planReport);
+  const cmp = compareReports(mine, r, what);
+  const shown = (await page.textContent('#stats-planes')).trim();
+  check(shown.startsWith(`${r.planes},`) && /deformed space/.test(shown), `planes shown as “${shown}”`);
+  const sim = await host(page, (el) => el.plan.verification?.summary);
+  check(sim && sim.gouge_count === 0 && sim.max_scallop_mm <= 0.05 * (1 + 1e-9), `simulated in the page: max scallop ${sim?.max_scallop_mm} mm, ${sim?.gouge_count} gouges`);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  check(g === cli.gcode, `the program is the CLI's --strategy isoplanar program (${g.length} vs ${cli.gcode.length} bytes)`);
+  await page.screenshot({ path: join(shots, 'isoplanar-keycap-convex.png') });
+  // Another strategy: the slicing controls wait, and the plan shown is stale.
+  await setParam(page, 'strategy', 'isoparametric');
+  check(await page.isDisabled('#p-slice-angle') && await page.isDisabled('#p-no-deform'), 'slicing controls disabled for another strategy');
+  check(await page.$eval(HOST, (el) => el.hasAttribute('data-stale')), 'the plan shown is stale');
+  return `${r.planes} planes, ${r.segments} pieces, ${r.retractions} retractions; simulated ${sim.max_scallop_mm.toFixed(4)} mm; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
+});
+
 test('watershed: bumps-hole in feature rectangles; the report from wasm is the CLI\'s key by key, the program the CLI\'s', async (page, url) => {
   const what = 'bumps-hole watershed';
   await page.goto(`${url}?model=bumps-hole&strategy=watershed&tool-radius=1&scallop=0.05&${SIM}`);
@@ -1111,7 +1142,7 @@ test('a strategy that is not one is named, planning waits, and the page stays us
   await setParam(page, 'strategy', 'isfc');
   check(await page.getAttribute('#p-strategy', 'aria-invalid') === 'false' && !(await page.isDisabled('#plan')), 'fixed by choosing');
   const offered = await page.$$eval('#p-strategy option', (o) => o.map((x) => x.value));
-  check(JSON.stringify(offered) === '["isoparametric","isfc","watershed","multi-rectangle"]', `the wrong value leaves the list: ${offered}`);
+  check(JSON.stringify(offered) === '["isoparametric","isfc","watershed","multi-rectangle","isoplanar"]', `the wrong value leaves the list: ${offered}`);
   await page.click('#plan');
   await waitPlans(page, 1);
   check(await attr(page, 'data-state') === 'planned' && (await stat(page, 'retractions')).value === 0, 'planned in one pass');

@@ -198,3 +198,33 @@ pub fn chart_point(
     }
     None
 }
+
+/// An open sheet cage from a profile in the XZ plane extruded along Y over `ny` quads of
+/// `dy` mm (boundary edges sharp, corners interpolated, as OBJ cages are read). With
+/// `triangles`, every other quad of the first row is split into two triangles.
+pub fn extruded_obj(profile: &[(f64, f64)], ny: usize, dy: f64, triangles: bool) -> String {
+    let mut s = String::new();
+    let np = profile.len();
+    for k in 0..=ny {
+        for &(x, z) in profile {
+            s += &format!("v {x} {} {z}\n", k as f64 * dy);
+        }
+    }
+    let id = |i: usize, k: usize| k * np + i + 1;
+    for k in 0..ny {
+        for i in 0..np - 1 {
+            let (a, b, c, d) = (id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1));
+            if triangles && k == 0 && i % 2 == 0 {
+                s += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+            } else {
+                s += &format!("f {a} {b} {c} {d}\n");
+            }
+        }
+    }
+    s
+}
+
+/// A model from OBJ text.
+pub fn obj_model(text: &str, name: &str) -> Model {
+    io::load(text.as_bytes(), name).unwrap()
+}

@@ -74,7 +74,7 @@ pub enum RatioForm {
 
 /// Steepest slope the ratio follows (degrees): steeper walls are sliced as if this steep
 /// (their passes would otherwise pile up without bound); the pass check fills them in.
-pub const MAX_SLOPE_DEG: f64 = 85.0;
+pub const MAX_SLOPE_DEG: f64 = 89.5;
 
 /// The largest ratio, [`MAX_SLOPE_DEG`] with the tightest concave curvature.
 pub fn max_ratio() -> f64 {
@@ -118,6 +118,12 @@ pub fn flat_spacing(r: f64, h: f64) -> f64 {
 
 /// The deformed coordinate `x' = X'(x)` (mm) over slabs of `x`: the largest ratio of each
 /// slab, integrated from the first slab's lower edge.
+///
+/// Where the surface turns to face along `x` (a closed part's side, a wall's foot) the ratio
+/// grows without bound as `1 / sin` of the angle from facing, yet its integral — the arc
+/// length — stays finite; a slab's ratio taken at a few points under-reads it there (the
+/// head, r 1 mm, h 0.05 mm: 0.24 mm left at its side). So the ratio is also taken over the
+/// mesh's edges as secants: an edge's length across the planes over its extent in `x`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Deformation {
     /// Lower edge of the first slab (mm).
@@ -131,12 +137,12 @@ pub struct Deformation {
 }
 
 impl Deformation {
-    /// From points `(x, ratio)` over `[x_lo, x_hi]` (mm) in slabs of width at least
-    /// `min_step` (mm) and at most `max_slabs` of them: each slab takes the largest ratio of
-    /// its points and its neighbours' (so a ratio near a slab's edge holds on both sides),
-    /// 1 where it has none.
+    /// From intervals `(x_a, x_b, ratio)` over `[x_lo, x_hi]` (mm) in slabs of width at
+    /// least `min_step` (mm) and at most `max_slabs` of them: each slab takes the largest
+    /// ratio of the intervals it meets and of its neighbours' (so a ratio near a slab's edge
+    /// holds on both sides), 1 where it meets none.
     pub fn new(
-        points: &[(f64, f64)],
+        intervals: &[(f64, f64, f64)],
         x_lo: f64,
         x_hi: f64,
         min_step: f64,
@@ -148,9 +154,11 @@ impl Deformation {
             .max(f64::MIN_POSITIVE);
         let n = ((span / step).ceil() as usize).max(1);
         let mut own = vec![1.0f64; n];
-        for &(x, e) in points {
-            let k = (((x - x_lo) / step).floor().max(0.0) as usize).min(n - 1);
-            own[k] = own[k].max(e);
+        let slab = |x: f64| (((x - x_lo) / step).floor().max(0.0) as usize).min(n - 1);
+        for &(a, b, e) in intervals {
+            for o in &mut own[slab(a.min(b))..=slab(a.max(b))] {
+                *o = o.max(e);
+            }
         }
         let ratio: Vec<f64> = (0..n)
             .map(|k| {
@@ -242,7 +250,7 @@ mod tests {
     #[test]
     fn the_deformed_coordinate_integrates_the_ratio_and_never_folds() {
         // Slabs of 1 mm over [0, 10]; a ratio of 2 at x = 5.5 raises slabs 4 to 6.
-        let d = Deformation::new(&[(5.5, 2.0), (1.2, 0.5)], 0.0, 10.0, 1.0, 100);
+        let d = Deformation::new(&[(5.5, 5.5, 2.0), (1.2, 1.6, 0.5)], 0.0, 10.0, 1.0, 100);
         assert_eq!((d.ratio.len(), d.step), (10, 1.0));
         assert_eq!(d.ratio[3], 1.0);
         assert_eq!(&d.ratio[4..7], &[2.0, 2.0, 2.0]);

@@ -2,10 +2,9 @@
 //! cut every shop knows, spaced so that the scallop stays near the limit on steep and
 //! concave areas too.
 //!
-//! The ball-centre (CL) surface is meshed from the exact limit surface ([`clmesh`]), seen
-//! from above as a height grid and deformed along the planes' normal so that constant
-//! spacing in the deformed space means the spacing the scallop allows in the original
-//! ([`deform`]); the deformed mesh is sliced by planes at the flat-floor spacing `d_w`
+//! The ball-centre (CL) surface is meshed from the exact limit surface ([`clmesh`]) and
+//! deformed along the planes' normal so that constant spacing in the deformed space means
+//! the spacing the scallop allows in the original ([`deform`]); the deformed mesh is sliced by planes at the flat-floor spacing `d_w`
 //! ([`slice`]), every slice point kept as the mesh edge and parameter it lies at, so that
 //! it maps back exactly; its contact point is then evaluated on the surface at that
 //! parameter. Pieces of a slice meeting at a patch seam are joined; the pieces are cut in a
@@ -14,7 +13,8 @@
 //! spaced `d_w` apart in plan view (the constant-spacing baseline). Where the cusp
 //! predicted between neighbouring passes (eq. 5 from the contact points' distance and the
 //! curvature across) would exceed the scallop, a pass half-way between is added over that
-//! stretch (`added_passes`), up to [`MAX_SPLITS`] times.
+//! stretch (`added_planes`), up to [`MAX_SPLITS`] times; last, a pass runs along the free
+//! boundary, which the planes' last passes may end short of where it is slanted or curved.
 //!
 //! The shared pipeline does the rest: tool axes (the project's collision-free axis, or the
 //! paper's normal with [`PlanOptions::lead_deg`]), lifting balls clear of creases and
@@ -64,6 +64,10 @@ const BESIDE_COS: f64 = 0.5;
 /// Most times the planes between two neighbours are halved where the predicted cusp is
 /// over the scallop.
 pub const MAX_SPLITS: usize = 3;
+/// Mesh edges whose extent in x is below this share of their length are not taken as
+/// secants for the deformation ratio (they run along a plane; an edge from a point where the
+/// surface faces along x spans about half its angle, a few hundredths).
+const SECANT_MIN_DX: f64 = 1e-3;
 /// Patch corners closer than this share of the model's diagonal are the same point.
 const BOUNDARY_JOIN_REL: f64 = 1e-7;
 /// Share of the overcut a thinned chord may leave at the slice points it passes over: the
@@ -157,7 +161,7 @@ pub fn plan(
 
 /// The scallop the planes are spaced for: the request less the chords' share, and eq. 5's
 /// small-h form made exact (it runs low by about h / 2r).
-fn side_scallop(opts: &PlanOptions) -> f64 {
+pub fn side_scallop(opts: &PlanOptions) -> f64 {
     let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
     h / (1.0 + h / (2.0 * opts.tool_radius_mm))
 }
@@ -235,9 +239,10 @@ pub fn slices(
             RatioForm::ExactPlane
         };
         // The ratio at every vertex of the mesh, from its exact normal and the curvature
-        // across the plane through it.
-        let mut points = Vec::with_capacity(mesh.vertices.len());
-        for (v, c) in mesh.vertices.iter().zip(&coords) {
+        // across the plane through it; and how much denser the curvature asks for.
+        let mut intervals = Vec::with_capacity(4 * mesh.vertices.len());
+        let mut need = vec![1.0; mesh.vertices.len()];
+        for (k, (v, c)) in mesh.vertices.iter().zip(&coords).enumerate() {
             let Some(v) = v else { continue };
             let Some(g) = geometry(model, v.patch, v.uv) else {
                 continue;
@@ -260,9 +265,41 @@ pub fn slices(
                 ),
                 None => (0.0, 0.0),
             };
-            points.push((c[0], deform::ratio(form, p, q, r, kx, ky)));
+            need[k] = deform::curvature_factor(r, kx);
+            intervals.push((c[0], c[0], deform::ratio(form, p, q, r, kx, ky)));
         }
-        Deformation::new(&points, x_lo, x_hi, SLAB_SHARE * spacing, MAX_SLABS)
+        // The edges as secants: their length across the planes (along the surface gradient
+        // of x at their middle) over their extent in x, times the curvature's need.
+        if form == RatioForm::ExactPlane {
+            let cap = deform::max_ratio();
+            for t in &mesh.triangles {
+                for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                    if a > b {
+                        continue;
+                    }
+                    let (va, vb) = (mesh.vertex(a), mesh.vertex(b));
+                    let (xa, xb) = (coords[a as usize][0], coords[b as usize][0]);
+                    let n = (va.normal + vb.normal)
+                        .try_normalize(1e-12)
+                        .unwrap_or(va.normal);
+                    let edge = vb.cl - va.cl;
+                    let grad = frame.x - n * frame.x.dot(&n);
+                    let across = match grad.try_normalize(1e-9) {
+                        Some(c) => edge.dot(&c).abs(),
+                        None => edge.norm(),
+                    };
+                    // Edges (nearly) along a plane cross no planes: left out, where the
+                    // ratio would be rounding over rounding.
+                    let dx = (xb - xa).abs();
+                    if dx <= SECANT_MIN_DX * edge.norm() {
+                        continue;
+                    }
+                    let e = need[a as usize].max(need[b as usize]) * across / dx;
+                    intervals.push((xa, xb, e.min(cap)));
+                }
+            }
+        }
+        Deformation::new(&intervals, x_lo, x_hi, SLAB_SHARE * spacing, MAX_SLABS)
     } else {
         Deformation::identity(x_lo, x_hi)
     };
@@ -987,24 +1024,37 @@ impl Emit<'_> {
             }
             prev = Some((*s, p));
         }
-        Ok(self.thin(out))
+        self.thin(out)
     }
 
     /// `points` without those the chords of their neighbours already hold: from each point
     /// kept, the next kept is the farthest one whose chord passes within the limits of every
     /// point between (the slice points lie as densely as the mesh's edges, far denser than
     /// the chordal tolerance asks for on gently curved stretches).
-    fn thin(&self, points: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
+    fn thin(&self, points: Vec<SurfacePoint>) -> Result<Vec<SurfacePoint>> {
         let n = points.len();
         if n < 3 {
-            return points;
+            return Ok(points);
+        }
+        // The curve half-way between neighbours too (where a chord dips furthest from it).
+        let mut middles: Vec<Option<SurfacePoint>> = Vec::with_capacity(n);
+        for w in points.windows(2) {
+            middles.push(if w[0].patch == w[1].patch {
+                let uv = [
+                    0.5 * (w[0].uv[0] + w[1].uv[0]),
+                    0.5 * (w[0].uv[1] + w[1].uv[1]),
+                ];
+                Some(self.point(w[0].patch, uv)?)
+            } else {
+                None
+            });
         }
         let holds = |i: usize, j: usize| {
             let (a, b) = (&points[i], &points[j]);
+            let on = |m: &SurfacePoint| m.patch == a.patch && self.chord_holds(a, b, m, THIN_SHARE);
             a.patch == b.patch
-                && points[i + 1..j]
-                    .iter()
-                    .all(|m| m.patch == a.patch && self.chord_holds(a, b, m, THIN_SHARE))
+                && points[i + 1..j].iter().all(on)
+                && middles[i..j].iter().all(|m| m.as_ref().is_some_and(on))
         };
         let mut keep = vec![0];
         let mut i = 0;
@@ -1016,7 +1066,7 @@ impl Emit<'_> {
             keep.push(j);
             i = j;
         }
-        keep.into_iter().map(|k| points[k]).collect()
+        Ok(keep.into_iter().map(|k| points[k]).collect())
     }
 
     /// Adds to `out` the points strictly between `a` and `b` (same patch) that bring the

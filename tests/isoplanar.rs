@@ -1,0 +1,290 @@
+//! Iso-planar slicing with CL-surface deformation (Yuan & Shao 2012; issue 16): closed forms
+//! on planes, the slices on their planes and back on the CL mesh, and the cut measured by
+//! the cutting simulation on the keycaps, the closed head (five-axis), the public bicycle
+//! seat and an OBJ cage, against the constant-spacing baseline.
+
+mod support;
+
+use support::{extruded_obj, obj_model, public_tsm};
+use tspath::geom::Point3;
+use tspath::machine::{self, Dialect, JobInfo, Units};
+use tspath::model::samples;
+use tspath::plan::isoplanar::{self, deform};
+use tspath::plan::{self, PlanOptions, Planned, Strategy};
+use tspath::tmesh::{ControlPoint, Scheme, TMesh};
+use tspath::verify;
+use tspath::Model;
+
+/// Iso-planar, three-axis, ball `r`, scallop `h` (mm).
+fn opts(r: f64, h: f64) -> PlanOptions {
+    let mut o = PlanOptions::default()
+        .with_tool_radius(r)
+        .with_scallop(h)
+        .with_strategy(Strategy::Isoplanar);
+    o.max_tilt_deg = 0.0;
+    o
+}
+
+/// A 20 × 20 mm plane through the origin inclined by `theta_deg` about Y (bicubic, one
+/// patch).
+fn inclined_plane(theta_deg: f64) -> Model {
+    let (s, c) = theta_deg.to_radians().sin_cos();
+    let mut points = Vec::with_capacity(16);
+    for j in 0..4 {
+        for i in 0..4 {
+            let (x, y) = (20.0 * (i as f64 / 3.0 - 0.5), 20.0 * (j as f64 / 3.0 - 0.5));
+            points.push(ControlPoint {
+                point: Point3::new(x * c, y, x * s),
+                weight: 1.0,
+            });
+        }
+    }
+    let mesh = TMesh::from_grid(
+        points,
+        4,
+        4,
+        &[0.0, 1.0, 0.0],
+        &[0.0, 1.0, 0.0],
+        Scheme::TSpline,
+    )
+    .unwrap();
+    Model::try_new("plane", "test", "mm", mesh).unwrap()
+}
+
+#[test]
+fn a_flat_plate_is_sliced_at_the_flat_floor_spacing_and_an_inclined_plane_closer_by_its_slope() {
+    let o = opts(1.0, 0.01);
+    let h = isoplanar::side_scallop(&o);
+    let d_w = deform::flat_spacing(1.0, h);
+    assert!((d_w - 2.0 * (2.0 * h - h * h).sqrt()).abs() < 1e-15);
+    for theta in [0.0f64, 30.0, 60.0] {
+        let m = inclined_plane(theta);
+        let s = isoplanar::slices(&m, &o, &mut |_| true).unwrap();
+        // The ratio is 1 / cos θ everywhere (1 on the flat plate).
+        let want = 1.0 / theta.to_radians().cos();
+        for &e in &s.deformation.ratio {
+            assert!((e - want).abs() < 1e-9 * want, "θ {theta}°: ratio {e}");
+        }
+        // The planes, in plan view: the CL points of each pass share one x, consecutive
+        // planes lie the deformed spacing × cos θ apart, and the deformed spacing is d_w
+        // (fitted evenly over the part, so at most d_w and within one plane of it).
+        let step = s.stats.slice_spacing_mm;
+        let n = s.stats.planes as f64;
+        assert!(step <= d_w * (1.0 + 1e-12) && step * (n + 1.0) >= d_w * n);
+        let mut xs: Vec<f64> = Vec::new();
+        for p in s.passes.iter().filter(|p| p.plane.is_finite()) {
+            let x0 = s.frame.coords(&p.points[0].mesh_cl)[0];
+            for q in &p.points {
+                assert!((s.frame.coords(&q.mesh_cl)[0] - x0).abs() < 1e-9);
+            }
+            xs.push(x0);
+        }
+        xs.sort_by(f64::total_cmp);
+        xs.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        assert_eq!(xs.len(), s.stats.planes, "θ {theta}°");
+        for w in xs.windows(2) {
+            let plan_view = w[1] - w[0];
+            assert!(
+                (plan_view - step * theta.to_radians().cos()).abs() < 1e-9,
+                "θ {theta}°: planes {plan_view} mm apart in plan view, {step} mm deformed"
+            );
+        }
+        println!(
+            "θ {theta}°: {} planes {:.5} mm apart in plan view (d_w {d_w:.5} mm × cos θ = {:.5})",
+            s.stats.planes,
+            step * theta.to_radians().cos(),
+            d_w * theta.to_radians().cos()
+        );
+    }
+}
+
+#[test]
+fn slices_lie_on_their_planes_and_map_back_onto_the_cl_mesh() {
+    for name in ["keycap-convex", "keycap-concave", "bumps-hole"] {
+        let m = samples::load_sample(name).unwrap();
+        let mut o = opts(0.5, 0.01);
+        o.slice_angle_deg = 30.0;
+        let s = isoplanar::slices(&m, &o, &mut |_| true).unwrap();
+        let size = m.surface.bbox().diagonal();
+        let mut checked = 0;
+        for p in s.passes.iter().filter(|p| p.plane.is_finite()) {
+            for q in &p.points {
+                // In the deformed space the point is exactly on its plane, on the deformed
+                // mesh edge (the edge's vertices mapped to (x', y, z)).
+                assert_eq!(q.deformed[0], p.plane);
+                let (a, b) = (s.mesh.vertex(q.hit.a).cl, s.mesh.vertex(q.hit.b).cl);
+                let deformed = |c: &Point3, xp: f64| {
+                    let f = s.frame.coords(c);
+                    Point3::new(xp, f[1], f[2])
+                };
+                let (da, db) = (
+                    deformed(&a, s.x_prime[q.hit.a as usize]),
+                    deformed(&b, s.x_prime[q.hit.b as usize]),
+                );
+                let t_prime = Point3::new(q.deformed[0], q.deformed[1], q.deformed[2]);
+                let ab = db - da;
+                let t = if ab.norm_squared() > 0.0 {
+                    (t_prime - da).dot(&ab) / ab.norm_squared()
+                } else {
+                    0.0
+                };
+                let on_edge = (da + ab * t - t_prime).norm();
+                assert!(
+                    on_edge <= 1e-9 * size,
+                    "{name}: {on_edge} mm off the deformed edge"
+                );
+                // Mapped back (eq. 11, the same parameter on the original edge): the CL mesh.
+                let back = a + (b - a) * t;
+                let residual = (back - q.mesh_cl).norm();
+                assert!(residual <= 1e-9 * size, "{name}: residual {residual} mm");
+                checked += 1;
+            }
+        }
+        println!("{name}: {checked} slice points on their planes and back on the CL mesh");
+        assert!(checked > 1000);
+    }
+}
+
+/// Plans and simulates as `plan --verify` does.
+fn plan_and_verify(m: &Model, o: &PlanOptions) -> (Planned, verify::Verification) {
+    let planned = plan::plan(m, o, &mut |_| true).unwrap();
+    let v = verify::verify_plan(
+        m,
+        &planned,
+        o,
+        Some(200_000),
+        verify::PLAN_VERIFY_MAX_SAMPLES,
+    )
+    .unwrap();
+    (planned, v)
+}
+
+#[test]
+fn every_ball_centre_is_a_radius_from_its_contact_and_the_cut_keeps_the_scallop() {
+    let wave: Vec<(f64, f64)> = (0..=8)
+        .map(|i| (5.0 * i as f64, 4.0 * (0.9 * i as f64).sin()))
+        .collect();
+    let cage = obj_model(&extruded_obj(&wave, 6, 5.0, false), "wave.obj");
+    let mut head = opts(1.0, 0.05);
+    head.max_tilt_deg = 120.0;
+    let mut bike = opts(0.5, 0.01);
+    bike.slice_angle_deg = 90.0;
+    let cases: Vec<(&str, Model, PlanOptions)> = vec![
+        (
+            "keycap-convex",
+            samples::load_sample("keycap-convex").unwrap(),
+            opts(0.5, 0.005),
+        ),
+        (
+            "keycap-concave",
+            samples::load_sample("keycap-concave").unwrap(),
+            opts(0.5, 0.005),
+        ),
+        (
+            "head (tilt ≤ 120°)",
+            samples::load_sample("head").unwrap(),
+            head,
+        ),
+        ("Bike.tsm (planes at 90°)", public_tsm("Bike.tsm"), bike),
+        ("wave cage (OBJ)", cage, opts(1.0, 0.05)),
+    ];
+    for (name, m, o) in cases {
+        let (planned, v) = plan_and_verify(&m, &o);
+        let r = planned.report(&o);
+        let h = o.scallop_mm;
+        println!(
+            "{name}: {} planes, {} pieces, {} retractions, {:.0} mm; simulated max {:.5} mm (bound {:.5}), p95 {:.5} mm, {} gouges (deepest {:.5} mm), uncut {:.4} % (rest {:.4} %); problems: {}",
+            r.planes.unwrap(),
+            r.segments.unwrap(),
+            r.retractions,
+            r.length_mm,
+            v.max_scallop_mm,
+            v.error_bound_mm,
+            v.p95_scallop_mm,
+            v.gouge_count,
+            v.max_gouge_mm,
+            100.0 * v.uncut_fraction,
+            100.0 * v.rest_fraction,
+            r.problems.iter().map(|p| p.kind.as_str()).collect::<Vec<_>>().join(", ")
+        );
+        // Every ball centre a radius along the normal from its contact point, or further
+        // where it was lifted clear of a spot tighter than the ball (a lifted ball touches
+        // another face, to within the overcut allowed).
+        let rr = o.tool_radius_mm;
+        for mv in planned
+            .toolpath
+            .moves
+            .iter()
+            .filter(|mv| mv.kind.on_surface())
+        {
+            let d = (mv.cl_point - mv.cc_point).norm();
+            assert!(
+                d >= rr - o.overcut_mm(),
+                "{name}: a ball centre {d} mm from its contact"
+            );
+        }
+        // The cut: nothing cut in (no ball centre nearer the surface than a radius, less
+        // the gouge tolerance), the scallop kept and proven.
+        assert_eq!(v.gouge_count, 0, "{name}: gouged {} mm", v.max_gouge_mm);
+        assert!(v.error_bound_mm <= 0.25 * h, "{name}: unproven");
+        assert!(
+            v.max_scallop_mm <= h * (1.0 + 1e-9),
+            "{name}: {} mm left at {:?}",
+            v.max_scallop_mm,
+            v.max_scallop_at_mm
+        );
+        assert!(v.uncut_fraction - v.rest_fraction < 1e-3, "{name}");
+    }
+}
+
+#[test]
+fn the_deformation_keeps_the_scallop_on_steep_walls_where_constant_spacing_does_not() {
+    for name in ["keycap-convex", "keycap-concave"] {
+        let m = samples::load_sample(name).unwrap();
+        let deformed = opts(0.5, 0.005);
+        let mut baseline = deformed.clone();
+        baseline.isoplanar_deform = false;
+        let (pd, vd) = plan_and_verify(&m, &deformed);
+        let (pb, vb) = plan_and_verify(&m, &baseline);
+        let (rd, rb) = (pd.report(&deformed), pb.report(&baseline));
+        println!(
+            "{name}: deformed {} planes, {:.0} mm, max {:.5} / p95 {:.5} mm, uncut {:.2} %; constant spacing {} planes, {:.0} mm, max {:.5} / p95 {:.5} mm, uncut {:.2} %",
+            rd.planes.unwrap(),
+            rd.length_mm,
+            vd.max_scallop_mm,
+            vd.p95_scallop_mm,
+            100.0 * vd.uncut_fraction,
+            rb.planes.unwrap(),
+            rb.length_mm,
+            vb.max_scallop_mm,
+            vb.p95_scallop_mm,
+            100.0 * vb.uncut_fraction
+        );
+        assert!(vd.p95_scallop_mm <= deformed.scallop_mm);
+        assert!(vd.max_scallop_mm <= deformed.scallop_mm * (1.0 + 1e-9));
+        assert!(
+            vb.max_scallop_mm > 2.0 * deformed.scallop_mm && vb.uncut_fraction > 0.01,
+            "{name}: the baseline leaves {} mm on the walls",
+            vb.max_scallop_mm
+        );
+    }
+}
+
+#[test]
+fn the_same_input_gives_the_same_program() {
+    let m = samples::load_sample("keycap-convex").unwrap();
+    let mut o = opts(0.5, 0.01);
+    o.slice_angle_deg = 30.0;
+    let mach = machine::definition::builtin("3-axis").unwrap();
+    let job = JobInfo {
+        model: "keycap-convex".into(),
+        strategy: "isoplanar".into(),
+    };
+    let program = || {
+        let p = plan::plan(&m, &o, &mut |_| true).unwrap();
+        machine::post(&p.toolpath, &o, &job, &mach, Dialect::LinuxCnc, Units::Mm).unwrap()
+    };
+    let a = program();
+    assert_eq!(a, program());
+    assert!(a.lines().count() > 1000);
+}
