@@ -8,6 +8,15 @@ use std::hint::black_box;
 use tspath::model::samples;
 use tspath::plan::{self, isfc, isoparametric, PlanOptions, Strategy};
 
+/// The moves of a whole plan of `m` with `o` (the shared pipeline included).
+fn whole_plan(m: &tspath::Model, o: &PlanOptions) -> usize {
+    plan::plan(m, o, &mut |_| true)
+        .unwrap()
+        .toolpath
+        .moves
+        .len()
+}
+
 fn bench_plan(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");
     group.sample_size(10);
@@ -57,15 +66,7 @@ fn bench_plan(c: &mut Criterion) {
         });
         for (label, o) in [("isoparametric", &opts), ("isfc", &curve)] {
             group.bench_function(format!("{name} whole plan {label}"), |b| {
-                b.iter(|| {
-                    black_box(
-                        plan::plan(&m, o, &mut |_| true)
-                            .unwrap()
-                            .toolpath
-                            .moves
-                            .len(),
-                    )
-                })
+                b.iter(|| black_box(whole_plan(&m, o)))
             });
         }
     }
@@ -77,15 +78,7 @@ fn bench_plan(c: &mut Criterion) {
             .with_scallop(0.01)
             .with_strategy(strategy);
         group.bench_function(format!("bumps-hole whole plan {}", strategy.name()), |b| {
-            b.iter(|| {
-                black_box(
-                    plan::plan(&m, &o, &mut |_| true)
-                        .unwrap()
-                        .toolpath
-                        .moves
-                        .len(),
-                )
-            })
+            b.iter(|| black_box(whole_plan(&m, &o)))
         });
     }
     // Iso-planar slicing (issue 16): the convex keycap at the paper's settings (target
@@ -98,15 +91,7 @@ fn bench_plan(c: &mut Criterion) {
         .with_strategy(Strategy::Isoplanar);
     o.max_tilt_deg = 0.0;
     group.bench_function("keycap-convex whole plan isoplanar", |b| {
-        b.iter(|| {
-            black_box(
-                plan::plan(&m, &o, &mut |_| true)
-                    .unwrap()
-                    .toolpath
-                    .moves
-                    .len(),
-            )
-        })
+        b.iter(|| black_box(whole_plan(&m, &o)))
     });
     group.finish();
 }

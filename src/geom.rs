@@ -43,3 +43,20 @@ impl Aabb {
         (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
     }
 }
+
+/// The point of the segment `a`–`b` nearest `p`.
+pub fn nearest_on_segment(p: &Point3, a: &Point3, b: &Point3) -> Point3 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a + ab * t
+}
+
+/// Distance from `p` to the segment `a`–`b` (mm).
+pub fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    (p - nearest_on_segment(p, a, b)).norm()
+}

@@ -17,7 +17,7 @@ use super::stepover::{self, FeedDir};
 use super::toolpath::{PatchRun, Toolpath};
 use super::PlanOptions;
 use crate::error::{Error, Result};
-use crate::geom::{Point3, Vector3};
+use crate::geom::{dist_to_segment, Point3, Vector3};
 use crate::layout::{ConnectionKind, Patch};
 use crate::model::Model;
 use crate::surface::{DiffGeom, Surface, SurfaceDerivs};
@@ -413,18 +413,6 @@ fn cusp_checked(
         }
     }
     Ok((out, worst))
-}
-
-/// Distance from `p` to the segment `a`–`b`.
-fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }
 
 /// Contact point and unit normal on a pass.

@@ -34,7 +34,7 @@ use super::pipeline::Planned;
 use super::stepover::FeedDir;
 use super::PlanOptions;
 use crate::error::{Error, Result};
-use crate::geom::{Aabb, Point3, Vector3};
+use crate::geom::{dist_to_segment, Aabb, Point3, Vector3};
 use crate::layout::ConnectionKind;
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
@@ -786,16 +786,4 @@ pub fn cusp_between(
         }
     }
     Ok(best)
-}
-
-/// Distance from `p` to the segment `a`–`b`.
-fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }

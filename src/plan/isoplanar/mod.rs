@@ -33,7 +33,7 @@ use super::pipeline::Planned;
 use super::stepover;
 use super::PlanOptions;
 use crate::error::{Error, Result};
-use crate::geom::{Point3, Vector3};
+use crate::geom::{dist_to_segment, nearest_on_segment, Point3, Vector3};
 use crate::model::Model;
 use crate::surface::DiffGeom;
 use serde::{Deserialize, Serialize};
@@ -1197,21 +1197,4 @@ impl Emit<'_> {
             ],
         }
     }
-}
-
-/// The point of the segment `a`–`b` nearest `p`.
-fn nearest_on_segment(p: &Point3, a: &Point3, b: &Point3) -> Point3 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    a + ab * t
-}
-
-/// Distance from `p` to the segment `a`–`b` (mm).
-fn dist_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
-    (p - nearest_on_segment(p, a, b)).norm()
 }
