@@ -17,7 +17,7 @@ const USAGE: &str = "usage:
               [--isfc-plain] [--slice-angle DEG] [--no-deform] [--shear]
               [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
-              [--axis-preset vertical|gan2014]
+              [--axis-preset vertical|gan2014|yuan2012]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [-o OUT.nc] [--report REPORT.json]
@@ -305,9 +305,10 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     match a.value("--axis-preset") {
         None | Some("vertical") => {}
         Some("gan2014") => opts = opts.with_paper_axis(),
+        Some("yuan2012") => opts.facet_normal_axis = true,
         Some(other) => {
             return Err(Error::Io(format!(
-                "--axis-preset: `{other}` is not a preset: vertical (the collision-free axis closest to +Z, the default) or gan2014 (10° lead from the surface normal, as in Gan et al. 2014)"
+                "--axis-preset: `{other}` is not a preset: vertical (the collision-free axis closest to +Z, the default), gan2014 (10° lead from the surface normal, as in Gan et al. 2014) or yuan2012 (iso-planar: the area-weighted normal of the CL facets near the ball, Yuan & Shao 2012 eq. 12)"
             )))
         }
     }
@@ -336,10 +337,13 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
         None => opts.max_tilt_deg,
     };
     if mach.rotaries.is_empty()
-        && (opts.max_tilt_deg != 0.0 || opts.lead_deg != 0.0 || opts.tilt_deg != 0.0)
+        && (opts.max_tilt_deg != 0.0
+            || opts.lead_deg != 0.0
+            || opts.tilt_deg != 0.0
+            || opts.facet_normal_axis)
     {
         return Err(Error::Io(
-            "a three-axis machine cannot tilt the tool: drop --max-tilt/--lead/--tilt or choose a five-axis --machine".into(),
+            "a three-axis machine cannot tilt the tool: drop --max-tilt/--lead/--tilt/--axis-preset or choose a five-axis --machine".into(),
         ));
     }
     if let Some(name) = a.value("--strategy") {

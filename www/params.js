@@ -17,7 +17,7 @@ export const PARAMS = [
   { key: 'slice-angle', field: 'slice_angle_deg', group: 'strategy', label: 'Slicing planes\u2019 normal, from +X in XY', unit: '°', kind: 'number', min: -360, max: 360, step: 5, default: 0, isoplanarOnly: true },
   { key: 'no-deform', field: 'isoplanar_deform', group: 'strategy', label: 'Constant plane spacing: the baseline, without the CL-surface deformation', kind: 'flag', default: false, invert: true, isoplanarOnly: true },
   { key: 'shear', field: 'isoplanar_shear', group: 'strategy', label: 'The paper\u2019s shear form of the deformation ratio (eq. 9, denser)', kind: 'flag', default: false, isoplanarOnly: true },
-  { key: 'axis-preset', field: null, group: 'strategy', label: 'Tool axis preset', kind: 'choice', choices: [['', 'none: lead and tilt as set under Tool axis'], ['gan2014', 'Gan et al. 2014: 10\u00b0 lead from the surface normal']], default: '', fiveAxis: true },
+  { key: 'axis-preset', field: null, group: 'strategy', label: 'Tool axis preset', kind: 'choice', choices: [['', 'none: lead and tilt as set under Tool axis'], ['gan2014', 'Gan et al. 2014: 10\u00b0 lead from the surface normal'], ['yuan2012', 'Yuan & Shao 2012: area-weighted normal of the CL facets (iso-planar)']], default: '', fiveAxis: true },
   // Tool
   { key: 'tool-radius', field: 'tool_radius_mm', group: 'tool', label: 'Ball-end radius', unit: 'mm', kind: 'number', min: 0.05, max: 25, step: 0.05, default: 0.5 },
   { key: 'shank-radius', field: 'shank_radius_mm', group: 'tool', label: 'Shank radius', unit: 'mm', kind: 'number', min: 0.05, max: 50, step: 0.05, default: null, auto: 'ball radius' },
@@ -154,6 +154,7 @@ export function planOptions(values, { fiveAxis, paperLeadDeg = 10 }) {
     o.lead_deg = paperLeadDeg;
     o.tilt_deg = 0;
   }
+  if (fiveAxis && values['axis-preset'] === 'yuan2012') o.facet_normal_axis = true;
   if (!fiveAxis) {
     o.max_tilt_deg = 0;
     o.lead_deg = 0;

@@ -743,7 +743,7 @@ export class TspathPlanner extends HTMLElement {
     const preset = this.$('p-axis-preset').value;
     for (const p of PARAMS.filter((q) => q.fiveAxis)) {
       const el = this.$(`p-${p.key}`);
-      const byPreset = five && preset && (p.key === 'lead' || p.key === 'tilt');
+      const byPreset = five && preset === 'gan2014' && (p.key === 'lead' || p.key === 'tilt');
       // A preset left on when the machine became three-axis stays changeable, to be undone.
       const stuck = !five && p.key === 'axis-preset' && !!preset;
       el.disabled = (!five && !stuck) || !!byPreset;

@@ -768,6 +768,13 @@ pub fn choose(
             if usable(obs, (&c, &normal), &a, opts) {
                 axis = a;
             }
+        } else if opts.facet_normal_axis && m.tool_axis != Vector3::z() {
+            // The strategy's own axis (iso-planar: the facets' area-weighted normal), within
+            // the largest tilt.
+            let a = m.tool_axis;
+            if a.z >= opts.max_tilt_deg.to_radians().cos() && usable(obs, (&c, &normal), &a, opts) {
+                axis = a;
+            }
         }
         let blocked_at = if axis == Vector3::z() {
             vertical_hit(obs, (&c, &normal), &m.cc_point, opts)

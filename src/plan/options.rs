@@ -78,6 +78,11 @@ pub struct PlanOptions {
     /// `isoplanar` only: the paper's shear form of the deformation ratio (eq. 9) instead of
     /// the exact plane form. Default false.
     pub isoplanar_shear: bool,
+    /// `isoplanar` only, five-axis: the tool axis along the area-weighted normal of the CL
+    /// mesh's facets within a tool radius of the ball centre (Yuan & Shao 2012, eq. 12),
+    /// where that axis keeps the shank and holder clear and tilts no more than
+    /// `max_tilt_deg`; elsewhere the usual axis. Default false.
+    pub facet_normal_axis: bool,
 }
 
 /// The strategies: what to cut, in which order. The shared pipeline decides how.
@@ -168,6 +173,7 @@ impl Default for PlanOptions {
             slice_angle_deg: 0.0,
             isoplanar_deform: true,
             isoplanar_shear: false,
+            facet_normal_axis: false,
         }
     }
 }

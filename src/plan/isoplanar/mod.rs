@@ -564,6 +564,64 @@ fn boundary_passes(model: &Model, mesh: &ClMesh) -> Vec<Pass> {
     out
 }
 
+/// The CL mesh's facets for the tool axis of eq. 12: area-weighted unit normals (on the
+/// tool's side) of the facets whose centre lies within `xi` of a ball centre.
+struct Facets {
+    /// Centre, area (mm²) and unit normal of each facet.
+    facets: Vec<(Point3, f64, Vector3)>,
+    xi: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl Facets {
+    fn new(mesh: &ClMesh, xi: f64) -> Self {
+        let xi = xi.max(1e-9);
+        let mut facets = Vec::with_capacity(mesh.triangles.len());
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for t in &mesh.triangles {
+            let v = t.map(|k| mesh.vertex(k));
+            let cross = (v[1].cl - v[0].cl).cross(&(v[2].cl - v[0].cl));
+            let side = v[0].normal + v[1].normal + v[2].normal;
+            let Some(n) = cross.try_normalize(1e-300) else {
+                continue;
+            };
+            let n = if n.dot(&side) < 0.0 { -n } else { n };
+            let centre = Point3::from((v[0].cl.coords + v[1].cl.coords + v[2].cl.coords) / 3.0);
+            cells
+                .entry([centre.x, centre.y, centre.z].map(|x| (x / xi).floor() as i64))
+                .or_default()
+                .push(facets.len() as u32);
+            facets.push((centre, 0.5 * cross.norm(), n));
+        }
+        Facets { facets, xi, cells }
+    }
+
+    /// Eq. 12 at ball centre `c`: the area-weighted mean normal of the facets within `xi`,
+    /// normalised; `None` if there are none.
+    fn normal_near(&self, c: &Point3) -> Option<Vector3> {
+        let k = [c.x, c.y, c.z].map(|x| (x / self.xi).floor() as i64);
+        let mut sum = Vector3::zeros();
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &i in self
+                        .cells
+                        .get(&[k[0] + dx, k[1] + dy, k[2] + dz])
+                        .into_iter()
+                        .flatten()
+                    {
+                        let (centre, area, n) = self.facets[i as usize];
+                        if (centre - c).norm() <= self.xi {
+                            sum += n * area;
+                        }
+                    }
+                }
+            }
+        }
+        sum.try_normalize(1e-300)
+    }
+}
+
 /// The slice point of `hit` on plane `c`.
 fn slice_point(mesh: &ClMesh, frame: &Frame, c: f64, hit: slice::Hit) -> SlicePoint {
     let (a, b) = (mesh.vertex(hit.a), mesh.vertex(hit.b));
@@ -965,6 +1023,14 @@ pub fn draft(
         stats.max_predicted_scallop_mm,
         stats.retractions,
     );
+    if opts.facet_normal_axis {
+        let facets = Facets::new(&s.mesh, r);
+        for m in d.toolpath.moves.iter_mut().filter(|m| m.kind.on_surface()) {
+            if let Some(n) = facets.normal_near(&m.cl_point) {
+                m.tool_axis = n;
+            }
+        }
+    }
     d.isoplanar = Some(stats);
     Ok(d)
 }
