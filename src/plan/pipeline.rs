@@ -186,14 +186,8 @@ pub fn finish(
         .collect();
     let points = rest_fps.len();
     rest_fps.extend(reach::cut_end_halves(&draft, &why));
-    let shares = reach::shares_left(model, &path, &rest_fps, opts.scallop_mm);
-    let mut with_share = rest_fps
-        .into_iter()
-        .zip(shares)
-        .map(|((f, w), s)| (f, w, s));
-    let footprints: Vec<_> = with_share.by_ref().take(points).collect();
-    let halves: Vec<_> = with_share.collect();
-    let rest = reach::rest(model, footprints, halves, &path);
+    let shares = reach::shares_left(model, &path, &rest_fps, opts.scallop_mm)?;
+    let rest = reach::rest(model, rest_fps, shares, points, &path);
     let area = model_area(model);
     progress(1.0);
     Ok(Planned {

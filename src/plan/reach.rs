@@ -12,12 +12,14 @@
 
 use super::draft::{Draft, Footprint};
 use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
+use crate::error::Result;
 use crate::geom::Point3;
 use crate::model::Model;
 use crate::surface::diffgeom::DiffGeom;
 use crate::verify::capsule::Capsule;
 use crate::verify::index::CapsuleIndex;
 use crate::verify::probe::{Material, Probe};
+use crate::verify::CutterPath;
 use serde::{Deserialize, Serialize};
 
 /// Why a part of the surface is not machined.
@@ -541,7 +543,10 @@ pub fn shares_left(
     path: &Toolpath,
     footprints: &[(Footprint, Why)],
     scallop_mm: f64,
-) -> Vec<f64> {
+) -> Result<Vec<f64>> {
+    if footprints.iter().all(|f| f.0.is_none()) {
+        return Ok(vec![0.0; footprints.len()]);
+    }
     let r = path.tool_radius_mm;
     let mut region = crate::geom::Aabb::empty();
     for (f, _) in footprints.iter().filter(|f| !f.0.is_none()) {
@@ -551,22 +556,15 @@ pub fn shares_left(
             region.grow(&p.subs(&model.surface, u, v));
         }
     }
-    if footprints.iter().all(|f| f.0.is_none()) {
-        return vec![0.0; footprints.len()];
-    }
     let grow = 3.0 * r;
     let (lo, hi) = (region.min.map(|x| x - grow), region.max.map(|x| x + grow));
     let inside = |p: &Point3| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]);
     // Every straight move of the path near them, as the simulation sweeps it.
-    let moves = &path.moves;
-    let mut capsules: Vec<Capsule> = moves
-        .windows(2)
-        .filter(|w| inside(&w[0].cl_point) || inside(&w[1].cl_point))
-        .map(|w| Capsule::new(w[0].cl_point, w[1].cl_point))
+    let capsules: Vec<Capsule> = CutterPath::from_toolpath(path)?
+        .capsules()
+        .into_iter()
+        .filter(|c| inside(&c.start) || inside(&c.end()))
         .collect();
-    if moves.len() == 1 {
-        capsules.push(Capsule::new(moves[0].cl_point, moves[0].cl_point));
-    }
     let box_ = crate::geom::Aabb { min: lo, max: hi };
     let index = CapsuleIndex::build(&capsules, r, &box_, r);
     let mut probe = FootprintProbe {
@@ -575,7 +573,7 @@ pub fn shares_left(
         side: model.tool_side(),
         unreached_mm: f64::INFINITY,
     };
-    footprints
+    Ok(footprints
         .iter()
         .map(|(f, why)| {
             if f.is_none() {
@@ -601,7 +599,7 @@ pub fn shares_left(
             });
             share.max(LEAST_SHARE)
         })
-        .collect()
+        .collect())
 }
 
 /// The parameter step of a grid of `n`² samples over footprint `f`.
@@ -813,23 +811,23 @@ pub fn cut_end_halves(draft: &Draft, skip: &[Option<Why>]) -> Vec<(Footprint, Wh
     out
 }
 
-/// The rest area of `footprints` (cut points left out, or kept but leaving too much) and of
-/// `halves` (parts of kept points' footprints, see [`cut_end_halves`]: area, but no cut
-/// points of their own), each with the share of its area left ([`shares_left`]), on
-/// `model`, its regions located against the final `path`.
+/// The rest area of `footprints` — the first `points` of them cut points left out or kept
+/// but leaving too much, the others parts of kept points' footprints (see
+/// [`cut_end_halves`]: area, but no cut points of their own) — each counting `shares` of its
+/// area ([`shares_left`]), on `model`, its regions located against the final `path`.
 pub fn rest(
     model: &Model,
-    footprints: Vec<(Footprint, Why, f64)>,
-    halves: Vec<(Footprint, Why, f64)>,
+    footprints: Vec<(Footprint, Why)>,
+    shares: Vec<f64>,
+    points: usize,
     path: &Toolpath,
 ) -> Rest {
-    let n_points = footprints.len();
     let ((fps, share), is_point): ((Vec<_>, Vec<f64>), Vec<bool>) = footprints
         .into_iter()
-        .chain(halves)
+        .zip(shares)
         .enumerate()
-        .filter(|(_, (f, ..))| !f.is_none())
-        .map(|(k, (f, w, s))| (((f, w), s), k < n_points))
+        .filter(|(_, (f, _))| !f.0.is_none())
+        .map(|(k, (f, s))| ((f, s), k < points))
         .unzip();
     let n = fps.len();
     let mut sets = Sets((0..n).collect());
@@ -1023,17 +1021,18 @@ mod tests {
         };
         let tight = fp(0.8, 0.9, 0.8, 0.9);
         let fps = vec![
-            (fp(0.0, 0.1, 0.0, 0.1), Why::ToolHits, 1.0),
-            (fp(0.1, 0.2, 0.0, 0.1), Why::ToolHits, 1.0),
-            (fp(0.15, 0.3, 0.1, 0.2), Why::ToolHits, 1.0),
-            (fp(0.5, 0.6, 0.5, 0.6), Why::ToolHits, 1.0),
-            (fp(0.6, 0.7, 0.5, 0.6), Why::FacesAway, 1.0),
-            (Footprint::NONE, Why::ToolHits, 1.0),
+            (fp(0.0, 0.1, 0.0, 0.1), Why::ToolHits),
+            (fp(0.1, 0.2, 0.0, 0.1), Why::ToolHits),
+            (fp(0.15, 0.3, 0.1, 0.2), Why::ToolHits),
+            (fp(0.5, 0.6, 0.5, 0.6), Why::ToolHits),
+            (fp(0.6, 0.7, 0.5, 0.6), Why::FacesAway),
+            (Footprint::NONE, Why::ToolHits),
             // Kept, a quarter of it measured above the scallop.
-            (tight, Why::TooTight, 0.25),
+            (tight, Why::TooTight),
         ];
+        let shares = vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.25];
         let whole = fp(0.0, 1.0, 0.0, 1.0).area_mm2(&m);
-        let rest = rest(&m, fps, Vec::new(), &Toolpath::default());
+        let rest = rest(&m, fps, shares, 7, &Toolpath::default());
         assert_eq!(rest.regions.len(), 4);
         assert_eq!(rest.regions[0].points, 3);
         let sum: f64 = rest.regions.iter().map(|r| r.area_mm2).sum();

@@ -491,7 +491,7 @@ fn footprint(grids: &[PatchGrid], v: &Vertex) -> Footprint {
 }
 
 /// Contact point and tool-side normal at patch parameters `uv`.
-fn point(view: &PatchView, uv: [f64; 2]) -> Result<(Point3, Vector3)> {
+pub(crate) fn point(view: &PatchView, uv: [f64; 2]) -> Result<(Point3, Vector3)> {
     let (u, v) = (uv[0].clamp(0.0, 1.0), uv[1].clamp(0.0, 1.0));
     let (p, n) = view.point_normal(u, v);
     let n = n.ok_or_else(|| Error::Degenerate {

@@ -35,7 +35,7 @@ use super::PlanOptions;
 use crate::error::{Error, Result};
 use crate::geom::{dist_to_segment, nearest_on_segment, Point3, Vector3};
 use crate::model::Model;
-use crate::surface::DiffGeom;
+use crate::surface::{DiffGeom, SurfaceDerivs};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
@@ -89,8 +89,6 @@ pub struct IsoplanarStats {
     /// Connected pieces of the slices cut (a plane may cut the surface in several), the
     /// passes along the boundary included.
     pub segments: usize,
-    /// Passes along the surface's free boundary (one per loop or open stretch).
-    pub boundary_passes: usize,
     /// Spacing of the planes in the deformed space (mm): `d_w`.
     pub slice_spacing_mm: f64,
     /// The planes' normal in the XY plane (degrees from +X).
@@ -102,8 +100,6 @@ pub struct IsoplanarStats {
     /// Slabs of `x` the ratio is taken over, and their width (mm).
     pub slabs: usize,
     pub slab_mm: f64,
-    /// Triangles of the CL mesh.
-    pub mesh_triangles: usize,
     /// Joins between pieces on the surface, and retractions between them.
     pub links: usize,
     pub retractions: usize,
@@ -131,8 +127,6 @@ pub struct Pass {
     pub plane: f64,
     pub points: Vec<SlicePoint>,
     pub closed: bool,
-    /// Added between two planes where the cusp needed it.
-    pub added: bool,
 }
 
 /// The slices before they become moves.
@@ -166,26 +160,35 @@ pub fn side_scallop(opts: &PlanOptions) -> f64 {
     h / (1.0 + h / (2.0 * opts.tool_radius_mm))
 }
 
-/// Tool-side fundamental forms of `model` at patch `patch`, `uv`.
-fn geometry(model: &Model, patch: u32, uv: [f64; 2]) -> Option<DiffGeom> {
+/// Derivatives and tool-side fundamental forms of `model` at patch `patch`, `uv`.
+fn geometry(model: &Model, patch: u32, uv: [f64; 2]) -> Option<(SurfaceDerivs, DiffGeom)> {
     let p = &model.layout.patches[patch as usize];
-    let g = DiffGeom::try_from_derivs(&p.derivs(&model.surface, uv[0], uv[1]))?;
-    Some(if model.tool_side() < 0.0 {
-        g.flipped()
-    } else {
-        g
-    })
+    let d = p.derivs(&model.surface, uv[0], uv[1]);
+    let g = DiffGeom::try_from_derivs(&d)?;
+    Some((
+        d,
+        if model.tool_side() < 0.0 {
+            g.flipped()
+        } else {
+            g
+        },
+    ))
+}
+
+/// The parameter step `(du, dv)` whose tangent `S_u du + S_v dv` is the tangent-plane
+/// projection of `dir` (the metric's inverse); zero where the metric degenerates.
+fn tangent_params(g: &DiffGeom, d: &SurfaceDerivs, dir: &Vector3) -> [f64; 2] {
+    let (a, b) = (d.su.dot(dir), d.sv.dot(dir));
+    let det = g.e * g.g - g.f * g.f;
+    if !(det > 0.0) {
+        return [0.0, 0.0];
+    }
+    [(g.g * a - g.f * b) / det, (g.e * b - g.f * a) / det]
 }
 
 /// Normal curvature of `g` in the tangent direction closest to `dir` (1/mm).
-fn curvature_along(g: &DiffGeom, dir: &Vector3, su: &Vector3, sv: &Vector3) -> f64 {
-    // (du, dv) with S_u du + S_v dv the tangent projection of dir: the metric's inverse.
-    let (a, b) = (su.dot(dir), sv.dot(dir));
-    let det = g.e * g.g - g.f * g.f;
-    if !(det > 0.0) {
-        return 0.0;
-    }
-    let (du, dv) = ((g.g * a - g.f * b) / det, (g.e * b - g.f * a) / det);
+fn curvature_along(g: &DiffGeom, d: &SurfaceDerivs, dir: &Vector3) -> f64 {
+    let [du, dv] = tangent_params(g, d, dir);
     if du == 0.0 && dv == 0.0 {
         return 0.0;
     }
@@ -244,7 +247,7 @@ pub fn slices(
         let mut need = vec![1.0; mesh.vertices.len()];
         for (k, (v, c)) in mesh.vertices.iter().zip(&coords).enumerate() {
             let Some(v) = v else { continue };
-            let Some(g) = geometry(model, v.patch, v.uv) else {
+            let Some((d, g)) = geometry(model, v.patch, v.uv) else {
                 continue;
             };
             let n = [g.normal.dot(&frame.x), g.normal.dot(&frame.y), g.normal.z];
@@ -256,12 +259,10 @@ pub fn slices(
             } else {
                 (f64::INFINITY, 0.0)
             };
-            let patch = &model.layout.patches[v.patch as usize];
-            let d = patch.derivs(&model.surface, v.uv[0], v.uv[1]);
             let (kx, ky) = match feed_frame(&g.normal, &frame.x) {
                 Some((t, across)) => (
-                    curvature_along(&g, &across, &d.su, &d.sv),
-                    curvature_along(&g, &t, &d.su, &d.sv),
+                    curvature_along(&g, &d, &across),
+                    curvature_along(&g, &d, &t),
                 ),
                 None => (0.0, 0.0),
             };
@@ -317,10 +318,7 @@ pub fn slices(
             }
         })
         .collect();
-    let (mut passes, step) = slice_all(&mesh, &frame, &x_prime, spacing, seam);
-    if !progress(0.6) {
-        return Err(Error::Cancelled);
-    }
+    // Each triangle's range of x'.
     let tri_range: Vec<(f64, f64)> = mesh
         .triangles
         .iter()
@@ -329,6 +327,10 @@ pub fn slices(
             (f[0].min(f[1]).min(f[2]), f[0].max(f[1]).max(f[2]))
         })
         .collect();
+    let (mut passes, step) = slice_all(&mesh, &frame, &x_prime, &tri_range, spacing, seam);
+    if !progress(0.6) {
+        return Err(Error::Cancelled);
+    }
     let tris_at = |c: f64| -> Vec<u32> {
         tri_range
             .iter()
@@ -357,7 +359,6 @@ pub fn slices(
         gap *= 0.5;
         for (c, near, _) in needs {
             let tris = tris_at(c);
-            let near: Vec<Point3> = near.into_iter().map(|n| n.0).collect();
             let mut kept: Vec<Pass> = Vec::new();
             for p in cut(c, &tris) {
                 kept.extend(keep_near(p, &near, LINK_SPACINGS * spacing));
@@ -369,7 +370,6 @@ pub fn slices(
         }
         passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
     }
-    passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
     let planes = {
         let mut v: Vec<f64> = passes.iter().map(|p| p.plane).collect();
         v.dedup();
@@ -377,14 +377,11 @@ pub fn slices(
     };
     // Last, a pass along the surface's free boundary: where a boundary runs slanted to the
     // planes, or curves, the last pass of a plane ends short of it.
-    let boundary = boundary_passes(model, &mesh);
-    let boundary_passes = boundary.len();
-    passes.extend(boundary);
+    passes.extend(boundary_passes(model, &mesh));
     let max_ratio = deformation.ratio.iter().copied().fold(1.0, f64::max);
     let stats = IsoplanarStats {
         planes,
         added_planes,
-        boundary_passes,
         segments: passes.len(),
         slice_spacing_mm: step,
         slice_angle_deg: opts.slice_angle_deg,
@@ -392,7 +389,6 @@ pub fn slices(
         max_ratio,
         slabs: deformation.ratio.len(),
         slab_mm: deformation.step,
-        mesh_triangles: mesh.triangles.len(),
         links: 0,
         retractions: 0,
         max_predicted_scallop_mm: predicted,
@@ -408,27 +404,21 @@ pub fn slices(
 }
 
 /// The passes of every plane over the mesh whose vertices have deformed coordinate
-/// `x_prime`: planes evenly over its extent, at most `spacing` apart, the first and last
-/// half a spacing in; and their spacing (mm).
+/// `x_prime` (each triangle's range of it `tri_range`): planes evenly over its extent, at
+/// most `spacing` apart, the first and last half a spacing in; and their spacing (mm).
 fn slice_all(
     mesh: &ClMesh,
     frame: &Frame,
     x_prime: &[f64],
+    tri_range: &[(f64, f64)],
     spacing: f64,
     seam: f64,
 ) -> (Vec<Pass>, f64) {
-    let (mut f_lo, mut f_hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    let tri_range: Vec<(f64, f64)> = mesh
-        .triangles
+    let (f_lo, f_hi) = tri_range
         .iter()
-        .map(|t| {
-            let f = t.map(|v| x_prime[v as usize]);
-            let (lo, hi) = (f[0].min(f[1]).min(f[2]), f[0].max(f[1]).max(f[2]));
-            f_lo = f_lo.min(lo);
-            f_hi = f_hi.max(hi);
-            (lo, hi)
-        })
-        .collect();
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &(a, b)| {
+            (lo.min(a), hi.max(b))
+        });
     let n_planes = ((f_hi - f_lo) / spacing).ceil().max(1.0) as usize;
     let step = (f_hi - f_lo) / n_planes as f64;
     let first = f_lo + 0.5 * step;
@@ -472,7 +462,6 @@ fn cut_plane(
                 .map(|h| slice_point(mesh, frame, c, *h))
                 .collect(),
             closed: ch.closed,
-            added: false,
         })
         .collect();
     join_at_seams(mesh, passes, seam)
@@ -521,7 +510,6 @@ fn boundary_passes(model: &Model, mesh: &ClMesh) -> Vec<Pass> {
                     plane: f64::INFINITY,
                     points,
                     closed: false,
-                    added: false,
                 });
             }
         }
@@ -722,7 +710,7 @@ fn too_wide(
     frame: &Frame,
     passes: &[Pass],
     gap: f64,
-) -> (Vec<(f64, Vec<(Point3, f64)>, f64)>, f64) {
+) -> (Vec<(f64, Vec<Point3>, f64)>, f64) {
     let r = opts.tool_radius_mm;
     let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
     // Per plane: every pass point's contact point, CL point and curvature across the feed,
@@ -750,13 +738,11 @@ fn too_wide(
             if last.is_some_and(|l| (s.mesh_cl - l).norm() < every) && i + 1 < n {
                 continue;
             }
-            let patch = &model.layout.patches[s.patch as usize];
-            let d = patch.derivs(&model.surface, s.uv[0], s.uv[1]);
-            let Some(g) = geometry(model, s.patch, s.uv) else {
+            let Some((d, g)) = geometry(model, s.patch, s.uv) else {
                 continue;
             };
-            // The pass's own direction here (it turns away from the plane's where the
-            // deformation changes across rows), and the curvature across it.
+            // The pass's own direction here (from its neighbours: a boundary pass's too),
+            // and the curvature across it.
             let (before, after) = (
                 p.points.get(i.wrapping_sub(1)).unwrap_or(s),
                 p.points.get(i + 1).unwrap_or(s),
@@ -770,7 +756,7 @@ fn too_wide(
                 continue;
             };
             let c = g.normal.cross(&t);
-            let kappa = curvature_along(&g, &c, &d.su, &d.sv);
+            let kappa = curvature_along(&g, &d, &c);
             plane.points.push((g.point, s.mesh_cl, kappa, t));
             if let Some(a) = last_cc {
                 plane.segments.push((a, g.point));
@@ -799,7 +785,7 @@ fn too_wide(
                 let k = kappa.min(stepover::MAX_CONCAVE_RK / r);
                 let predicted = stepover::predicted_scallop(d, r, k);
                 if predicted > h {
-                    near.push((cl, (predicted / h).sqrt()));
+                    near.push(cl);
                     worst = worst.max(predicted);
                 } else {
                     worst_ok = worst_ok.max(predicted);
@@ -913,7 +899,6 @@ fn keep_near(pass: Pass, near: &[Point3], reach: f64) -> Vec<Pass> {
             plane: pass.plane,
             points,
             closed: false,
-            added: true,
         })
         .collect()
 }
@@ -931,11 +916,11 @@ pub fn draft(
     let mut out = DraftBuilder::new(model, opts);
     let ctx = Emit {
         model,
+        views: super::isoparametric::patch_views(model),
         r,
         chordal: opts.chordal_mm,
         overcut: opts.overcut_mm(),
         leave: CHORD_SCALLOP_SHARE * opts.scallop_mm,
-        side: model.tool_side(),
         spacing,
         h: side_scallop(opts),
     };
@@ -1038,13 +1023,13 @@ pub fn draft(
 /// What placing moves needs.
 struct Emit<'a> {
     model: &'a Model,
+    views: Vec<super::isoparametric::PatchView<'a>>,
     r: f64,
     chordal: f64,
     overcut: f64,
     /// Most a ball-centre chord may pass above its curve (mm): the scallop's share for
     /// chords.
     leave: f64,
-    side: f64,
     /// Flat-floor slice spacing (mm).
     spacing: f64,
     /// The scallop the planes were spaced for (mm).
@@ -1054,18 +1039,12 @@ struct Emit<'a> {
 impl Emit<'_> {
     /// The surface point of patch `patch` at `uv`.
     fn point(&self, patch: u32, uv: [f64; 2]) -> Result<SurfacePoint> {
-        let uv = [uv[0].clamp(0.0, 1.0), uv[1].clamp(0.0, 1.0)];
-        let p = &self.model.layout.patches[patch as usize];
-        let (cc, n) = p.point_normal(&self.model.surface, uv[0], uv[1]);
-        let n = n.ok_or_else(|| Error::Degenerate {
-            location: format!("patch {patch} at (u, v) = ({:.6}, {:.6})", uv[0], uv[1]),
-            message: "the surface has no tangent plane here or nearby".into(),
-        })?;
+        let (cc, normal) = super::isfc::point(&self.views[patch as usize], uv)?;
         Ok(SurfacePoint {
             patch,
-            uv,
+            uv: [uv[0].clamp(0.0, 1.0), uv[1].clamp(0.0, 1.0)],
             cc,
-            normal: n * self.side,
+            normal,
         })
     }
 
@@ -1073,13 +1052,11 @@ impl Emit<'_> {
     /// the chords of the contact and ball-centre curves are within their limits.
     fn refine(&self, pts: &[SlicePoint]) -> Result<Vec<SurfacePoint>> {
         let mut out: Vec<SurfacePoint> = Vec::with_capacity(pts.len());
-        let mut prev: Option<(SlicePoint, SurfacePoint)> = None;
+        let mut prev: Option<SurfacePoint> = None;
         for s in pts {
             let p = self.point(s.patch, s.uv)?;
-            if let Some((ps, pp)) = prev {
-                if ps.patch == s.patch {
-                    self.split(s.patch, (ps.uv, &pp), (s.uv, &p), CHORD_DEPTH, &mut out)?;
-                }
+            if let Some(pp) = prev.filter(|pp| pp.patch == p.patch) {
+                self.split(&pp, &p, CHORD_DEPTH, &mut out)?;
             }
             // Drop repeats (a slice through a mesh vertex crosses its edges there twice).
             if out
@@ -1088,7 +1065,7 @@ impl Emit<'_> {
             {
                 out.push(p);
             }
-            prev = Some((*s, p));
+            prev = Some(p);
         }
         self.thin(out)
     }
@@ -1135,27 +1112,26 @@ impl Emit<'_> {
         Ok(keep.into_iter().map(|k| points[k]).collect())
     }
 
-    /// Adds to `out` the points strictly between `a` and `b` (same patch) that bring the
-    /// chords within the limits.
+    /// Adds to `out` the points strictly between `pa` and `pb` (same patch) on the straight
+    /// parameter line between them that bring the chords within the limits.
     fn split(
         &self,
-        patch: u32,
-        (ua, pa): ([f64; 2], &SurfacePoint),
-        (ub, pb): ([f64; 2], &SurfacePoint),
+        pa: &SurfacePoint,
+        pb: &SurfacePoint,
         depth: usize,
         out: &mut Vec<SurfacePoint>,
     ) -> Result<()> {
         if depth == 0 {
             return Ok(());
         }
-        let um = [0.5 * (ua[0] + ub[0]), 0.5 * (ua[1] + ub[1])];
-        let pm = self.point(patch, um)?;
+        let (ua, ub) = (pa.uv, pb.uv);
+        let pm = self.point(pa.patch, [0.5 * (ua[0] + ub[0]), 0.5 * (ua[1] + ub[1])])?;
         if self.chord_holds(pa, pb, &pm, 1.0) {
             return Ok(());
         }
-        self.split(patch, (ua, pa), (um, &pm), depth - 1, out)?;
+        self.split(pa, &pm, depth - 1, out)?;
         out.push(pm);
-        self.split(patch, (um, &pm), (ub, pb), depth - 1, out)
+        self.split(&pm, pb, depth - 1, out)
     }
 
     /// Whether the straight move from `a` to `b` passes within the limits of `m`, a point of
@@ -1199,7 +1175,7 @@ impl Emit<'_> {
         line: u32,
     ) -> Result<()> {
         let mut pts = Vec::new();
-        self.split(a.patch, (a.uv, a), (b.uv, b), CHORD_DEPTH, &mut pts)?;
+        self.split(a, b, CHORD_DEPTH, &mut pts)?;
         for p in &pts {
             out.link(p, line, Footprint::NONE);
         }
@@ -1235,13 +1211,7 @@ impl Emit<'_> {
             .try_normalize(1e-12)
             .unwrap_or_else(|| d.su.normalize());
         let step = 0.5 * (8.0 * self.r * self.h).sqrt();
-        let (x, y) = (d.su.dot(&across) * step, d.sv.dot(&across) * step);
-        let det = g.e * g.g - g.f * g.f;
-        let c = if det > 0.0 {
-            [(g.g * x - g.f * y) / det, (g.e * y - g.f * x) / det]
-        } else {
-            [0.0, 0.0]
-        };
+        let c = tangent_params(&g, &d, &(across * step));
         let mut lo = p.uv;
         let mut hi = p.uv;
         for corner in [a, b] {
