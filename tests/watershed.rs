@@ -217,3 +217,98 @@ fn refinement_along_the_boxes_keeps_the_surface_and_makes_box_sides_mesh_edges()
         worst / size
     );
 }
+
+/// Sum of the areas of flat triangles, `x y z` per corner (mm²).
+fn triangles_area(t: &[f32]) -> f64 {
+    t.chunks_exact(9)
+        .map(|c| {
+            let p = |k: usize| {
+                tspath::geom::Vector3::new(
+                    c[3 * k] as f64,
+                    c[3 * k + 1] as f64,
+                    c[3 * k + 2] as f64,
+                )
+            };
+            0.5 * (p(1) - p(0)).cross(&(p(2) - p(0))).norm()
+        })
+        .sum()
+}
+
+/// The page's layer of regions and rectangles on `bumps-hole`: the fills tile the surface
+/// (their area equals the model's tessellated area, which comes from the model's own
+/// layout, not the rectangles), each region kind's fills equal the report's region areas,
+/// and every rectangle's arrow points along the passes the plan cut there.
+#[test]
+fn the_rectangles_layer_tiles_the_surface_and_points_along_the_passes() {
+    let m = samples::load_sample("bumps-hole").unwrap();
+    let o = opts(Strategy::Watershed);
+    let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
+    let report = planned.report(&o);
+    let layer = planned.watershed_layer.clone().unwrap();
+    let rects = report.rectangles.clone().unwrap();
+    assert_eq!(layer.rectangle_count(), rects.len());
+    assert_eq!(layer.fill_kinds.len() * 9, layer.fills.len());
+    let size = m.surface.bbox().diagonal();
+    let t = m.tessellate(1e-4 * size);
+    let model_area = triangles_area(
+        &t.indices
+            .iter()
+            .flat_map(|&i| t.positions[3 * i as usize..3 * i as usize + 3].to_vec())
+            .collect::<Vec<f32>>(),
+    );
+    let fills_area = triangles_area(&layer.fills);
+    println!("fills {fills_area:.3} mm² vs the model's {model_area:.3} mm²");
+    assert!((fills_area - model_area).abs() <= 2e-3 * model_area);
+    let regions = report.regions.clone().unwrap();
+    for (kind, code) in [
+        (tspath::plan::watershed::FeatureKind::Convex, 1u8),
+        (tspath::plan::watershed::FeatureKind::Concave, 2u8),
+    ] {
+        let reported: f64 = regions
+            .iter()
+            .filter(|r| r.kind == kind)
+            .map(|r| r.area_mm2)
+            .sum();
+        let drawn: Vec<f32> = layer
+            .fills
+            .chunks_exact(9)
+            .zip(&layer.fill_kinds)
+            .filter(|(_, &k)| k == code)
+            .flat_map(|(c, _)| c.to_vec())
+            .collect();
+        let drawn = triangles_area(&drawn);
+        println!("{kind:?}: drawn {drawn:.3} mm², reported {reported:.3} mm²");
+        assert!(reported > 0.0);
+        assert!((drawn - reported).abs() <= 5e-3 * reported);
+    }
+    // Each arrow's shaft against the feed moves of its rectangle: the length-weighted mean
+    // |cos| of the angle between them (1 along the passes; cutting across would give the
+    // step-over's small share).
+    let moves = &planned.toolpath.moves;
+    for (k, shaft) in layer.arrows.chunks_exact(18).enumerate() {
+        let a = tspath::geom::Vector3::new(
+            (shaft[3] - shaft[0]) as f64,
+            (shaft[4] - shaft[1]) as f64,
+            (shaft[5] - shaft[2]) as f64,
+        )
+        .normalize();
+        let (mut along, mut total) = (0.0, 0.0);
+        for w in moves.windows(2) {
+            if w[1].kind == tspath::plan::toolpath::MoveKind::Feed
+                && w[0].patch == k as u32
+                && w[1].patch == k as u32
+            {
+                let d = w[1].cc_point - w[0].cc_point;
+                along += d.dot(&a).abs();
+                total += d.norm();
+            }
+        }
+        assert!(total > 0.0, "rectangle {k} has no cuts");
+        println!(
+            "rectangle {k}: {:?}, along the arrow {:.3}",
+            rects[k].crossfeed,
+            along / total
+        );
+        assert!(along / total > 0.8, "rectangle {k}: {}", along / total);
+    }
+}

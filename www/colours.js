@@ -49,6 +49,18 @@ export const hexCss = (c) => `#${c.toString(16).padStart(6, '0')}`;
  * patch side. */
 export const ISFC_LAYER = { cell: 0x1f3b73, tree: 0xd81b60, across: 0xff8f00 };
 
+/** The watershed strategies' layer: rectangle fills by region kind (in the order of
+ * `Plan.rectangleKinds()`: background, convex, concave), outlines and direction arrows. */
+export const RECT_LAYER = {
+  kinds: [
+    { name: 'background', label: 'outside feature regions', colour: 0xb9c0ca },
+    { name: 'convex', label: 'in convex feature regions (bosses)', colour: 0xe4572e },
+    { name: 'concave', label: 'in concave feature regions (dimples)', colour: 0x2e86de },
+  ],
+  outline: 0x1b1f3b,
+  arrow: 0x111111,
+};
+
 /** Why part of the surface is left as rest area, in the order of `Plan.restReasons()`
  * (0–3) and with the name the report's rest regions use (`why`). */
 export const REST_REASONS = [

@@ -15,7 +15,7 @@
 // that the parameters no longer match the plan shown (its downloads are off).
 import { CancelledError, EngineClient } from './client.js';
 import {
-  ISFC_LAYER, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour,
+  ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
 } from './colours.js';
 import { area, bytes, deg, int, minutes, mm, mmSig, ms, pct, share } from './format.js';
 import { GROUPS, PARAMS, byKey, flagOn, planOptions, validate } from './params.js';
@@ -70,6 +70,42 @@ const PROBLEM_KINDS = {
   unproven: 'Not proven by the simulation',
 };
 
+/** The layers a plan of some strategies brings along (drawn without planning again), each
+ * with its view setter, legend heading, box titles and legend rows (`[colour, text, filled]`). */
+const OVERLAYS = {
+  isfc: {
+    setter: 'setIsfc',
+    heading: 'Space-filling curve',
+    title: 'The 2 × 2 cells of grid points and the tree that joins them into one pass',
+    none: 'Only a space-filling-curve plan (strategy: one continuous pass) has cells and a tree',
+    rows: (c) => {
+      const nAcross = c.across.reduce((a, x) => a + x, 0);
+      return [
+        [ISFC_LAYER.cell, `${int(c.cells.length / 24)} cell outlines (grid lines between contact points)`],
+        [ISFC_LAYER.tree, `${int(c.tree.length / 6 - nAcross)} tree links between cell centres`],
+        [ISFC_LAYER.across, `${int(nAcross)} tree links across patch sides`],
+      ];
+    },
+  },
+  rects: {
+    setter: 'setRects',
+    heading: 'Regions and rectangles',
+    title: 'The rectangles the surface was cut into, coloured by feature region, each with an arrow along its passes',
+    none: 'Only the rectangle strategies (watershed, multi-rectangle) cut the surface into rectangles',
+    rows: (r) => {
+      const count = r.arrows.length / 18;
+      const perRect = count ? r.kinds.length / count : 1;
+      const byKind = RECT_LAYER.kinds.map(() => 0);
+      for (const k of r.kinds) byKind[k]++;
+      return [
+        ...RECT_LAYER.kinds.map((k, i) => [k.colour, `${int(byKind[i] / perRect)} ${byKind[i] === perRect ? 'rectangle' : 'rectangles'} ${k.label}`, true]).filter((_, i) => byKind[i]),
+        [RECT_LAYER.outline, `${int(count)} rectangle outlines`],
+        [RECT_LAYER.arrow, 'arrows: the way the passes run in each'],
+      ];
+    },
+  },
+};
+
 const TEMPLATE = `
 <div class="app" part="app">
   <aside class="controls" aria-label="Model and parameters">
@@ -100,7 +136,8 @@ const TEMPLATE = `
       <div id="drop-hint" class="drop-hint" hidden>Drop a .tsm, .obj or .json model to open it</div>
       <div id="heat-legend" class="heat-legend" hidden aria-label="Heat map colours"></div>
       <div id="rest-legend" class="rest-legend" hidden aria-label="Rest area colours"></div>
-      <div id="isfc-legend" class="isfc-legend" hidden aria-label="Cells and tree colours"></div>
+      <div id="isfc-legend" class="overlay-legend" hidden aria-label="Cells and tree colours"></div>
+      <div id="rects-legend" class="overlay-legend" hidden aria-label="Regions and rectangles colours"></div>
     </div>
     <div class="layers" role="group" aria-label="What the view shows">
       <span class="radio" role="radiogroup" aria-label="Surface colours">
@@ -108,7 +145,8 @@ const TEMPLATE = `
         <label class="inline"><input type="radio" name="colour" id="colour-heat" value="heat" disabled> Scallop heat map</label>
       </span>
       <label class="inline" title="What the plan leaves unmachined, coloured by why"><input type="checkbox" id="layer-rest" checked disabled> Rest area</label>
-      <label class="inline" id="layer-isfc-label" title="Space-filling-curve plans: the 2 × 2 cells of grid points and the tree that joins them into one pass"><input type="checkbox" id="layer-isfc" disabled> Cells and tree</label>
+      <label class="inline" id="layer-isfc-label" title="${OVERLAYS.isfc.none}"><input type="checkbox" id="layer-isfc" disabled> Cells and tree</label>
+      <label class="inline" id="layer-rects-label" title="${OVERLAYS.rects.none}"><input type="checkbox" id="layer-rects" disabled> Regions and rectangles</label>
       <label class="inline"><input type="checkbox" id="layer-path" checked> Path</label>
       <label class="inline"><input type="checkbox" id="layer-tool" checked> Tool</label>
       <label class="inline"><input type="checkbox" id="layer-cage"> Control mesh</label>
@@ -237,6 +275,8 @@ export class TspathPlanner extends HTMLElement {
 
   constructor() {
     super();
+    /** Plan layers (OVERLAYS) the user turned on, kept for the next plans. */
+    this.overlayShown = {};
     this.root = this.attachShadow({ mode: 'open' });
     const css = document.createElement('link');
     css.rel = 'stylesheet';
@@ -469,10 +509,12 @@ export class TspathPlanner extends HTMLElement {
       this.#showRestLayer();
     });
     // Drawn from what the plan brought along: showing it does not plan again.
-    $('layer-isfc').addEventListener('change', () => {
-      this.isfcShown = $('layer-isfc').checked; // kept for the next plans
-      this.#showIsfcLayer();
-    });
+    for (const key of Object.keys(OVERLAYS)) {
+      $(`layer-${key}`).addEventListener('change', () => {
+        this.overlayShown[key] = $(`layer-${key}`).checked; // kept for the next plans
+        this.#showOverlayLayer(key);
+      });
+    }
     $('problems').addEventListener('click', (e) => {
       const b = e.target.closest('button[data-move]');
       if (b) this.#showMove(Number(b.dataset.move), b.dataset.at ? JSON.parse(b.dataset.at) : null);
@@ -928,7 +970,7 @@ export class TspathPlanner extends HTMLElement {
     this.plan = { ...result, planReport: result.report, options, values: v.values, workerHasPlan: true };
     this.view.setPath(result);
     this.#showRest();
-    this.#showIsfc();
+    for (const key of Object.keys(OVERLAYS)) this.#showOverlay(key);
     this.#showTool(v.values);
     const n = result.kinds.length;
     const scrub = this.$('scrub');
@@ -1106,7 +1148,7 @@ export class TspathPlanner extends HTMLElement {
       this.view.setTool(null);
       this.view.setHeat(null);
       this.view.setRest(null);
-      this.view.setIsfc(null);
+      for (const o of Object.values(OVERLAYS)) this.view[o.setter](null);
     }
     this.$('colour-heat').disabled = true;
     this.$('scrub').disabled = true;
@@ -1122,9 +1164,11 @@ export class TspathPlanner extends HTMLElement {
     this.$('heat-legend').hidden = true;
     this.$('rest-legend').hidden = true;
     this.$('layer-rest').disabled = true;
-    this.$('isfc-legend').hidden = true;
-    this.$('layer-isfc').disabled = true;
-    this.$('layer-isfc').checked = false;
+    for (const key of Object.keys(OVERLAYS)) {
+      this.$(`${key}-legend`).hidden = true;
+      this.$(`layer-${key}`).disabled = true;
+      this.$(`layer-${key}`).checked = false;
+    }
     delete this.dataset.verify;
     delete this.dataset.status;
     this.#markStale(false);
@@ -1303,47 +1347,39 @@ export class TspathPlanner extends HTMLElement {
     this.$('rest-legend').hidden = !on;
   }
 
-  /** A space-filling-curve plan's cells and tree in the view (a layer, off until asked for),
-   * and its legend. Other plans have none: the box is off and says why. */
-  #showIsfc() {
-    const c = this.plan?.isfc;
-    this.view.setIsfc(c ? { cells: c.cells, tree: c.tree, across: c.across } : null);
-    const box = this.$('layer-isfc');
-    box.disabled = !c;
-    box.checked = !!c && !!this.isfcShown;
-    this.$('layer-isfc-label').title = c
-      ? 'The 2 × 2 cells of grid points and the tree that joins them into one pass'
-      : 'Only a space-filling-curve plan (strategy: one continuous pass) has cells and a tree';
-    const legend = this.$('isfc-legend');
+  /** A plan's own layer (OVERLAYS: a space-filling curve's cells and tree, a watershed
+   * plan's regions and rectangles) in the view, off until asked for, and its legend. Plans
+   * of other strategies have none: the box is off and says why. */
+  #showOverlay(key) {
+    const spec = OVERLAYS[key];
+    const data = this.plan?.[key] || null;
+    this.view[spec.setter](data);
+    const box = this.$(`layer-${key}`);
+    box.disabled = !data;
+    box.checked = !!data && !!this.overlayShown[key];
+    this.$(`layer-${key}-label`).title = data ? spec.title : spec.none;
+    const legend = this.$(`${key}-legend`);
     legend.replaceChildren();
-    if (c) {
-      const nCells = c.cells.length / 24;
-      const nLinks = c.tree.length / 6;
-      const nAcross = c.across.reduce((a, x) => a + x, 0);
+    if (data) {
       const title = document.createElement('div');
       title.className = 'title';
-      title.textContent = 'Space-filling curve';
-      const line = (colour, text) => {
+      title.textContent = spec.heading;
+      const rows = spec.rows(data).map(([colour, text, fill]) => {
         const sw = document.createElement('span');
-        sw.className = 'swatch line';
+        sw.className = fill ? 'swatch' : 'swatch line';
         sw.style.setProperty('--c', hexCss(colour));
         sw.textContent = text;
         return sw;
-      };
-      legend.append(
-        title,
-        line(ISFC_LAYER.cell, `${int(nCells)} cell outlines (grid lines between contact points)`),
-        line(ISFC_LAYER.tree, `${int(nLinks - nAcross)} tree links between cell centres`),
-        line(ISFC_LAYER.across, `${int(nAcross)} tree links across patch sides`),
-      );
+      });
+      legend.append(title, ...rows);
     }
-    this.#showIsfcLayer();
+    this.#showOverlayLayer(key);
   }
 
-  #showIsfcLayer() {
-    const on = this.$('layer-isfc').checked && !this.$('layer-isfc').disabled;
-    this.view.setLayers({ isfc: on });
-    this.$('isfc-legend').hidden = !on;
+  #showOverlayLayer(key) {
+    const on = this.$(`layer-${key}`).checked && !this.$(`layer-${key}`).disabled;
+    this.view.setLayers({ [key]: on });
+    this.$(`${key}-legend`).hidden = !on;
   }
 
   // ---------------------------------------------------------------- view
@@ -1552,7 +1588,7 @@ export class TspathPlanner extends HTMLElement {
     return n;
   }
 
-  /** Pixels a layer (`path`, `tool`, `cage`, `eps`, `rest`, `isfc`) changes when shown (it is left
+  /** Pixels a layer (`path`, `tool`, `cage`, `eps`, `rest`, `isfc`, `rects`) changes when shown (it is left
    * as it was). */
   layerPixels(layer) {
     const on = this.view.layers[layer];

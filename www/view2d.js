@@ -1,11 +1,12 @@
 // Fallback view for browsers without WebGL, on a 2D canvas: shaded surface triangles
 // (painter's algorithm), patch colours or the heat map, the rest area a plan leaves (by
 // reason, sorted with the surface, and a ring at each region), a space-filling curve's cells
-// and tree (projected like everything else, drawn over the surface), extraordinary points,
+// and tree and the watershed rectangles (projected like everything else, drawn over the
+// surface), extraordinary points,
 // control mesh, the path by kind and the tool as its outline. Same interface as View3D. Z is
 // up; mm.
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, hexCss, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
 } from './colours.js';
 
 const rgb = (c) => [c >> 16 & 255, c >> 8 & 255, c & 255];
@@ -27,7 +28,7 @@ export class View2D {
     this.isfc = null;
     this.center = [0, 0, 0];
     this.radius = 1;
-    this.layers = { surface: true, rest: true, isfc: false, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true };
     this.#bindInput();
     this.resizer = new ResizeObserver(() => this.resize());
     this.resizer.observe(canvas);
@@ -66,6 +67,12 @@ export class View2D {
   /** A space-filling curve's cells and tree (see View3D.setIsfc) or null. */
   setIsfc(isfc) {
     this.isfc = isfc && isfc.cells.length ? isfc : null;
+    this.render();
+  }
+
+  /** The watershed rectangles (see View3D.setRects) or null. */
+  setRects(rects) {
+    this.rects = rects && rects.fills.length ? rects : null;
     this.render();
   }
 
@@ -160,18 +167,35 @@ export class View2D {
     ctx.fillRect(0, 0, width, height);
     if (!this.model) return;
     const proj = this.#project();
-    if (this.layers.surface || (this.layers.rest && this.rest)) this.#drawSurface(proj);
+    const overlays = this.#overlays();
+    if (this.layers.surface || overlays.length) this.#drawSurface(proj, overlays);
     if (this.layers.rest && this.rest) this.#drawRestRings(proj);
     if (this.layers.isfc && this.isfc) this.#drawIsfc(proj);
+    if (this.layers.rects && this.rects) this.#drawRects(proj);
     if (this.layers.cage) this.#drawCage(proj);
     if (this.layers.eps) this.#drawEps(proj);
     if (this.layers.path && this.path) this.#drawPath(proj);
     if (this.layers.tool && this.tool) this.#drawTool(proj);
   }
 
-  /** Surface triangles and, with the rest layer, the rest triangles, sorted together by
-   * depth (a rest triangle a little nearer than the surface it lies on). */
-  #drawSurface(proj) {
+  /** Triangles drawn over the surface, sorted with it: the rest area (by reason) and the
+   * watershed rectangles (by region kind), each `{ positions, colour(t), alpha }`. */
+  #overlays() {
+    const out = [];
+    if (this.layers.rest && this.rest) {
+      const why = this.rest.reasons;
+      out.push({ positions: this.rest.positions, alpha: 0.85, colour: (t) => (REST_REASONS[why[t]] || REST_REASONS[0]).colour });
+    }
+    if (this.layers.rects && this.rects) {
+      const kinds = this.rects.kinds;
+      out.push({ positions: this.rects.fills, alpha: 0.8, colour: (t) => (RECT_LAYER.kinds[kinds[t]] || RECT_LAYER.kinds[0]).colour });
+    }
+    return out;
+  }
+
+  /** Surface triangles and the overlays' triangles, sorted together by depth (an overlay
+   * triangle a little nearer than the surface it lies on). */
+  #drawSurface(proj, overlays) {
     const ctx = this.ctx;
     const { positions: p, normals: n, indices: idx, patchIds } = this.model;
     const nv = p.length / 3;
@@ -181,14 +205,24 @@ export class View2D {
       sx[i] = q[0]; sy[i] = q[1]; sd[i] = q[2];
     }
     const nt = this.layers.surface ? idx.length / 3 : 0;
-    const rest = this.layers.rest && this.rest ? this.rest : null;
-    const rp = rest ? rest.positions : [];
-    const nr = rp.length / 9;
-    const rx = new Float32Array(3 * nr), ry = new Float32Array(3 * nr), rd = new Float32Array(3 * nr);
-    for (let i = 0; i < 3 * nr; i++) {
-      const q = proj(rp[3 * i], rp[3 * i + 1], rp[3 * i + 2]);
-      rx[i] = q[0]; ry[i] = q[1]; rd[i] = q[2];
+    // Overlay triangle r is triangle r - first[o] of overlay o.
+    const first = [];
+    let nr = 0;
+    for (const o of overlays) {
+      first.push(nr);
+      nr += o.positions.length / 9;
     }
+    const rx = new Float32Array(3 * nr), ry = new Float32Array(3 * nr), rd = new Float32Array(3 * nr);
+    overlays.forEach((o, k) => {
+      const rp = o.positions;
+      for (let i = 0; i < rp.length / 3; i++) {
+        const q = proj(rp[3 * i], rp[3 * i + 1], rp[3 * i + 2]);
+        const j = 3 * first[k] + i;
+        rx[j] = q[0]; ry[j] = q[1]; rd[j] = q[2];
+      }
+    });
+    const which = new Uint8Array(nr);
+    overlays.forEach((o, k) => which.fill(k, first[k], first[k] + o.positions.length / 9));
     const order = new Uint32Array(nt + nr);
     const depth = new Float32Array(nt + nr);
     for (let t = 0; t < nt; t++) {
@@ -206,8 +240,9 @@ export class View2D {
     for (const t of order) {
       if (t >= nt) {
         const r = t - nt;
-        ctx.fillStyle = hexCss((REST_REASONS[rest.reasons[r]] || REST_REASONS[0]).colour);
-        ctx.globalAlpha = 0.85;
+        const o = overlays[which[r]];
+        ctx.fillStyle = hexCss(o.colour(r - first[which[r]]));
+        ctx.globalAlpha = o.alpha;
         ctx.beginPath();
         ctx.moveTo(rx[3 * r], ry[3 * r]);
         ctx.lineTo(rx[3 * r + 1], ry[3 * r + 1]);
@@ -261,28 +296,36 @@ export class View2D {
     }
   }
 
+  /** Line segments (`x y z x y z` each) for which `which(s)` holds, in one colour. */
+  #segments(proj, a, which, colour, width, alpha) {
+    const ctx = this.ctx;
+    ctx.strokeStyle = hexCss(colour);
+    ctx.lineWidth = width;
+    ctx.globalAlpha = alpha;
+    ctx.beginPath();
+    for (let i = 0, s = 0; i < a.length; i += 6, s++) {
+      if (!which(s)) continue;
+      const p = proj(a[i], a[i + 1], a[i + 2]);
+      const q = proj(a[i + 3], a[i + 4], a[i + 5]);
+      ctx.moveTo(p[0], p[1]);
+      ctx.lineTo(q[0], q[1]);
+    }
+    ctx.stroke();
+    ctx.globalAlpha = 1;
+  }
+
   /** Cell outlines, then the tree's links (those across a patch side in their own colour). */
   #drawIsfc(proj) {
-    const ctx = this.ctx;
-    const segments = (a, which, colour, width, alpha) => {
-      ctx.strokeStyle = hexCss(colour);
-      ctx.lineWidth = width;
-      ctx.globalAlpha = alpha;
-      ctx.beginPath();
-      for (let i = 0, s = 0; i < a.length; i += 6, s++) {
-        if (!which(s)) continue;
-        const p = proj(a[i], a[i + 1], a[i + 2]);
-        const q = proj(a[i + 3], a[i + 4], a[i + 5]);
-        ctx.moveTo(p[0], p[1]);
-        ctx.lineTo(q[0], q[1]);
-      }
-      ctx.stroke();
-      ctx.globalAlpha = 1;
-    };
     const { cells, tree, across } = this.isfc;
-    segments(cells, () => true, ISFC_LAYER.cell, 0.75, 0.7);
-    segments(tree, (s) => !across[s], ISFC_LAYER.tree, 1.25, 1);
-    segments(tree, (s) => across[s], ISFC_LAYER.across, 1.5, 1);
+    this.#segments(proj, cells, () => true, ISFC_LAYER.cell, 0.75, 0.7);
+    this.#segments(proj, tree, (s) => !across[s], ISFC_LAYER.tree, 1.25, 1);
+    this.#segments(proj, tree, (s) => across[s], ISFC_LAYER.across, 1.5, 1);
+  }
+
+  /** The rectangles' outlines and arrows (their fills are sorted with the surface). */
+  #drawRects(proj) {
+    this.#segments(proj, this.rects.outlines, () => true, RECT_LAYER.outline, 1, 0.9);
+    this.#segments(proj, this.rects.arrows, () => true, RECT_LAYER.arrow, 1.5, 1);
   }
 
   #drawCage(proj) {

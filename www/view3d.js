@@ -1,13 +1,13 @@
 // The 3D view with three.js (vendored in www/vendor/): shaded surface with patches in
 // colours (or the scallop heat map), extraordinary points, optional control mesh, the rest
 // area a plan leaves (coloured by reason, with a ring at each region), a space-filling
-// curve's cells and tree (off until shown), the tool path by
+// curve's cells and tree and the watershed rectangles (off until shown), the tool path by
 // patch with links and retractions drawn apart, and the tool (ball, shank, holder).
 // Z is up; lengths are millimetres. Renders on demand, not in a loop.
 import * as THREE from './vendor/three.module.js';
 import { OrbitControls } from './vendor/OrbitControls.js';
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, REST_REASONS, heatColour, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, pathColour,
 } from './colours.js';
 
 const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
@@ -30,7 +30,7 @@ export class View3D {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.screenSpacePanning = true;
     this.controls.addEventListener('change', () => this.render());
-    this.layers = { surface: true, rest: true, isfc: false, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true };
     this.groups = {};
     for (const k of Object.keys(this.layers)) {
       this.groups[k] = new THREE.Group();
@@ -233,6 +233,40 @@ export class View3D {
         const tree = lines(isfc.tree, fill(isfc.tree.length / 6, (s) => (isfc.across[s] ? ISFC_LAYER.across : ISFC_LAYER.tree)), 1);
         tree.renderOrder = 4;
         this.groups.isfc.add(tree);
+      }
+    }
+    this.render();
+  }
+
+  /** The watershed strategies' rectangles: `fills` (Float32Array, `x y z` per triangle
+   * corner, on the surface, mm) with `kinds` (Uint8Array per triangle, an index into
+   * RECT_LAYER.kinds), `outlines` and `arrows` (Float32Array, `x y z x y z` per segment);
+   * null for none. Fills translucent over the surface, outlines and arrows over them. */
+  setRects(rects) {
+    this.#clear(this.groups.rects);
+    if (rects && rects.fills.length) {
+      const n = rects.kinds.length;
+      const col = new Float32Array(9 * n);
+      const c = new THREE.Color();
+      for (let t = 0; t < n; t++) {
+        c.setHex((RECT_LAYER.kinds[rects.kinds[t]] || RECT_LAYER.kinds[0]).colour);
+        for (let k = 0; k < 3; k++) col.set([c.r, c.g, c.b], 9 * t + 3 * k);
+      }
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(rects.fills), 3));
+      g.setAttribute('color', new THREE.BufferAttribute(col, 3));
+      const fills = new THREE.Mesh(g, new THREE.MeshBasicMaterial({
+        vertexColors: true, side: THREE.DoubleSide, transparent: true, opacity: 0.8,
+        depthWrite: false, polygonOffset: true, polygonOffsetFactor: -1, polygonOffsetUnits: -2,
+      }));
+      fills.renderOrder = 2;
+      this.groups.rects.add(fills);
+      for (const [positions, colour, order] of [[rects.outlines, RECT_LAYER.outline, 3], [rects.arrows, RECT_LAYER.arrow, 4]]) {
+        const lg = new THREE.BufferGeometry();
+        lg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(positions), 3));
+        const lines = new THREE.LineSegments(lg, new THREE.LineBasicMaterial({ color: colour }));
+        lines.renderOrder = order;
+        this.groups.rects.add(lines);
       }
     }
     this.render();

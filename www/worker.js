@@ -106,9 +106,15 @@ const ops = {
       isfc: report.strategy === 'isfc' ? {
         cells: plan.isfcCells(), tree: plan.isfcTree(), across: plan.isfcTreeAcross(), start: plan.isfcStart(),
       } : null,
+      // The watershed strategies' rectangles, for the layer.
+      rects: ['watershed', 'multi-rectangle'].includes(report.strategy) ? {
+        fills: plan.rectangleFills(), kinds: plan.rectangleKinds(), outlines: plan.rectangleOutlines(), arrows: plan.rectangleArrows(),
+      } : null,
     };
     const transfer = ['cl', 'cc', 'axes', 'kinds', 'patchIds', 'rest', 'restReasons'].map((k) => result[k].buffer);
-    if (result.isfc) transfer.push(...Object.values(result.isfc).map((a) => a.buffer));
+    for (const layer of [result.isfc, result.rects]) {
+      if (layer) transfer.push(...Object.values(layer).map((a) => a.buffer));
+    }
     return { result, transfer };
   },
 

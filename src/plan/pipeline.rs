@@ -63,6 +63,9 @@ pub struct Planned {
     pub layout: Option<crate::layout::PatchLayout>,
     /// The watershed strategies' regions and rectangles.
     pub watershed: Option<super::watershed::plan::WatershedStats>,
+    /// The watershed rectangles as triangles and segments, for drawing (the watershed
+    /// strategies only; set after the pipeline).
+    pub watershed_layer: Option<super::watershed::layer::Layer>,
     /// What the slices are made of (`isoplanar` only).
     pub isoplanar: Option<super::isoplanar::IsoplanarStats>,
 }
@@ -196,6 +199,7 @@ pub fn finish(
         isfc_layer: None,
         layout: None,
         watershed: None,
+        watershed_layer: None,
         strategy: draft.strategy,
         toolpath: path,
         forced_retractions: draft.forced_retractions,

@@ -9,6 +9,7 @@ use crate::error::Error;
 use crate::machine::{self, Dialect, JobInfo, Units};
 use crate::model::{samples, Model};
 use crate::plan::isfc::layer::Layer as IsfcLayer;
+use crate::plan::watershed::layer::Layer as WatershedLayer;
 use crate::plan::{PlanOptions, PlanReport, Toolpath};
 use crate::surface::tessellate::Tessellation;
 use crate::verify::{self, CutterPath, RestRect, Verification, VerifyOptions};
@@ -236,6 +237,7 @@ impl WasmModel {
         };
         Ok(WasmPlan {
             isfc_layer: planned.isfc_layer,
+            watershed_layer: planned.watershed_layer,
             path: planned.toolpath,
             report,
             opts,
@@ -293,6 +295,8 @@ pub struct WasmPlan {
     rest_why: Vec<u8>,
     /// The space-filling curve's cells and tree (`isfc` plans only), kept from planning.
     isfc_layer: Option<IsfcLayer>,
+    /// The rectangles (`watershed` and `multi-rectangle` plans only), kept from planning.
+    watershed_layer: Option<WatershedLayer>,
 }
 
 impl WasmPlan {
@@ -301,6 +305,16 @@ impl WasmPlan {
         self.isfc_layer.as_ref().ok_or_else(|| {
             JsError::new(&format!(
                 "this plan's strategy is {}: only a space-filling-curve plan (strategy isfc) has cells and a tree to draw",
+                self.report.strategy
+            ))
+        })
+    }
+
+    /// The rectangles layer, or an error saying that only the watershed strategies have one.
+    fn rectangles(&self) -> Result<&WatershedLayer, JsError> {
+        self.watershed_layer.as_ref().ok_or_else(|| {
+            JsError::new(&format!(
+                "this plan's strategy is {}: only the watershed and multi-rectangle strategies cut the surface into rectangles to draw",
                 self.report.strategy
             ))
         })
@@ -412,6 +426,35 @@ impl WasmPlan {
     pub fn isfc_start(&self) -> Result<js_sys::Float64Array, JsError> {
         let s = self.layer()?.start_mm.map_or(Vec::new(), |p| p.to_vec());
         Ok(js_sys::Float64Array::from(&s[..]))
+    }
+
+    /// `watershed` and `multi-rectangle` plans: every rectangle filled with triangles on the
+    /// surface, `x y z` per corner (mm), in the order of the plan's patches. Throws for other
+    /// strategies.
+    #[wasm_bindgen(js_name = rectangleFills)]
+    pub fn rectangle_fills(&self) -> Result<js_sys::Float32Array, JsError> {
+        Ok(js_sys::Float32Array::from(&self.rectangles()?.fills[..]))
+    }
+
+    /// Per triangle of `rectangleFills`, its rectangle's region: 0 background, 1 convex,
+    /// 2 concave. Throws for other strategies.
+    #[wasm_bindgen(js_name = rectangleKinds)]
+    pub fn rectangle_kinds(&self) -> Result<js_sys::Uint8Array, JsError> {
+        Ok(js_sys::Uint8Array::from(&self.rectangles()?.fill_kinds[..]))
+    }
+
+    /// The rectangles' sides on the surface, `x y z x y z` per segment (mm). Throws for
+    /// other strategies.
+    #[wasm_bindgen(js_name = rectangleOutlines)]
+    pub fn rectangle_outlines(&self) -> Result<js_sys::Float32Array, JsError> {
+        Ok(js_sys::Float32Array::from(&self.rectangles()?.outlines[..]))
+    }
+
+    /// Per rectangle an arrow along its passes (shaft and two barbs, three segments,
+    /// `x y z x y z` each, mm). Throws for other strategies.
+    #[wasm_bindgen(js_name = rectangleArrows)]
+    pub fn rectangle_arrows(&self) -> Result<js_sys::Float32Array, JsError> {
+        Ok(js_sys::Float32Array::from(&self.rectangles()?.arrows[..]))
     }
 
     /// The default G-code program, in mm: three-axis (plain dialect) while the tool axis

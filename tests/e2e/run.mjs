@@ -1126,7 +1126,22 @@ test('watershed: bumps-hole in feature rectangles; the report from wasm is the C
   const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
   check(g === cli.gcode, `the program is the CLI's --strategy watershed program (${g.length} vs ${cli.gcode.length} bytes)`);
   await page.screenshot({ path: join(shots, 'watershed-bumps-hole.png') });
-  return `${r.regions.length} regions, ${r.rectangles.length} rectangles, ${r.reversals} reversals; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
+  // The regions and rectangles layer: offered (the cells and tree are not), off until shown;
+  // its legend counts the CLI's rectangles per region kind.
+  check(await page.isDisabled('#layer-isfc') && !(await page.isDisabled('#layer-rects')) && !(await page.isChecked('#layer-rects')), 'the rectangles are offered, off until shown; no cells and tree');
+  const px = await host(page, (el) => el.layerPixels('rects'));
+  check(px > 5000, `the regions and rectangles change ${px} px when shown`);
+  await page.check('#layer-rects');
+  const legend = await page.textContent('#rects-legend');
+  const inKind = (kind) => r.rectangles.filter((x) => x.region !== null && r.regions[x.region].kind === kind).length;
+  const nConvex = inKind('convex');
+  const nConcave = inKind('concave');
+  const nBack = r.rectangles.filter((x) => x.region === null).length;
+  check([[nConvex, 'in convex'], [nConcave, 'in concave'], [nBack, 'outside']].every(([n, w]) => legend.includes(`${n} ${n === 1 ? 'rectangle' : 'rectangles'} ${w}`)) && legend.includes(`${r.rectangles.length} rectangle outlines`), `legend: ${legend}`);
+  await page.screenshot({ path: join(shots, 'watershed-regions-rectangles.png') });
+  await page.uncheck('#layer-rects');
+  check(await page.isHidden('#rects-legend'), 'the legend goes with the layer');
+  return `${r.regions.length} regions, ${r.rectangles.length} rectangles (${nConvex} convex, ${nConcave} concave, ${nBack} background; layer ${px} px), ${r.reversals} reversals; wasm = native: ${cmp.exact} of ${cmp.numbers} numbers bit-equal (largest relative difference ${cmp.worst.toExponential(1)}); G-code = CLI`;
 });
 
 test('a strategy that is not one is named, planning waits, and the page stays usable', async (page, url) => {
@@ -1195,6 +1210,17 @@ test('without WebGL the 2D view draws the cells and tree', async (page, url) => 
   check(px > 1000, `cells and tree drawn in 2D (${px} px)`);
   await page.check('#layer-isfc');
   await page.screenshot({ path: join(shots, 'isfc-fallback-2d.png') });
+  return `${px} px`;
+}, { noWebGL: true });
+
+test('without WebGL the 2D view draws the regions and rectangles', async (page, url) => {
+  await page.goto(`${url}?model=bumps&strategy=watershed&tool-radius=1&scallop=0.05&${SIM}&plan=1`);
+  await waitPlans(page, 1);
+  check(await attr(page, 'data-renderer') === '2d', 'the fallback view is used');
+  const px = await host(page, (el) => el.layerPixels('rects'));
+  check(px > 5000, `regions and rectangles drawn in 2D (${px} px)`);
+  await page.check('#layer-rects');
+  await page.screenshot({ path: join(shots, 'watershed-fallback-2d.png') });
   return `${px} px`;
 }, { noWebGL: true });
 

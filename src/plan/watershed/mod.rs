@@ -7,6 +7,7 @@
 //! change the model (refinement belongs to [`crate::tmesh::refine`]).
 
 pub mod boxes;
+pub mod layer;
 pub mod map;
 pub mod plan;
 pub mod rects;

@@ -5,6 +5,7 @@
 //! links, axes, lifting, air moves, rest area) is the isoparametric draft and the shared
 //! pipeline.
 
+use super::layer::{FillKind, Layer};
 use super::{features, map, rects, FeatureKind, DEFAULT_TOR};
 use crate::error::{Error, Result};
 use crate::layout::PatchLayout;
@@ -114,6 +115,20 @@ pub fn plan(
     let mut planned = pipeline::plan_with(&cut, opts, progress, DRAFT_SHARE, |p| {
         isoparametric::draft_with(&cut, opts, p, Some(&crossfeeds), name)
     })?;
+    let kinds: Vec<FillKind> = rects
+        .iter()
+        .map(|r| {
+            match r
+                .feature
+                .and_then(|l| regions.as_ref()?.get(l as usize - 1))
+                .map(|x| x.kind)
+            {
+                Some(FeatureKind::Convex) => FillKind::Convex,
+                Some(FeatureKind::Concave) => FillKind::Concave,
+                None => FillKind::Background,
+            }
+        })
+        .collect();
     // Each region's area: its rectangles' on the surface.
     let regions = regions.map(|mut regions| {
         for (k, r) in rects.iter().enumerate() {
@@ -127,6 +142,15 @@ pub fn plan(
         }
         regions
     });
+    // The way each rectangle was cut: its first run's (the order's transits may turn a
+    // rectangle from the rule's direction where that joins it to its neighbours).
+    let mut cut_ways = crossfeeds.clone();
+    for run in planned.toolpath.runs.iter().rev() {
+        if let Some(c) = cut_ways.get_mut(run.patch as usize) {
+            *c = run.crossfeed;
+        }
+    }
+    planned.watershed_layer = Some(Layer::of(&cut, &kinds, &cut_ways));
     planned.watershed = Some(WatershedStats {
         regions,
         map_points,
