@@ -27,10 +27,13 @@ const USAGE: &str = "usage:
               (default 8 000 000) until its error bound is a quarter of the scallop
               exits with 3 after writing its outputs when the plan has problems (rest area,
               gouges, scallop over the request, an unproven simulation), listed on stderr
-  tspath compare MODEL [plan's options] [--verify [--verify-max-samples N]] [--markdown]
-              plans MODEL with both strategies; prints the area, the flat-surface bound
-              L_min = area / sqrt(8 r h) and each plan's lengths, retractions, time (and
-              with --verify the simulated scallop) as JSON or a Markdown table row
+  tspath compare MODEL [plan's options] [--strategies a,b,...] [--no-verify]
+              [--verify-max-samples N] [--report C.json] [--csv C.csv]
+              plans MODEL with every strategy (isoparametric, isfc, watershed,
+              multi-rectangle, isoplanar, isoplanar-baseline), simulates each cut, and
+              prints a Markdown table: lengths, retractions, reversals, CL points, simulated
+              scallop, gouges, axis step, plan and machining time (on --machine), and the
+              cutting length over L_min = integral of dA / g (curvature) and area/sqrt(8 r h)
   tspath machine --list
   tspath machine NAME [-o FILE.json]
   tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
@@ -373,6 +376,7 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
     let planned = plan::plan(&m, &opts, &mut |_| true)?;
     let mut report = planned.report(&opts);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
+    report.set_machining_time(&planned.toolpath, &opts, &mach);
     let gcode = machine::post(
         &planned.toolpath,
         &opts,
@@ -418,29 +422,50 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
     Ok((out, status))
 }
 
-/// `compare`: both strategies on one model, as JSON or a Markdown table row.
+/// `compare`: every strategy (or those `--strategies` names) on one model, each cut
+/// simulated unless `--no-verify`; a Markdown table on stdout, JSON with `--report`, CSV
+/// with `--csv`.
 fn compare_cmd(args: &[String]) -> Result<String> {
-    let a = parse(args, PLAN_FLAGS, &[PLAN_SWITCHES, &["--markdown"]].concat())?;
-    let (m, _, opts) = plan_setup(&a)?;
-    let max = if a.has("--verify") {
+    let a = parse(
+        args,
+        &[PLAN_FLAGS, &["--strategies", "--csv"]].concat(),
+        &[PLAN_SWITCHES, &["--no-verify"]].concat(),
+    )?;
+    if a.value("--strategy").is_some() || a.value("-o").is_some() {
+        return Err(Error::Io(
+            "compare plans every strategy and writes no program: use --strategies a,b,... to choose some, and --report/--csv for its files".into(),
+        ));
+    }
+    let (m, mach, opts) = plan_setup(&a)?;
+    let entries = plan::compare::Entry::parse_list(a.value("--strategies"))?;
+    let max = if a.has("--no-verify") {
+        None
+    } else {
         Some(
             a.count("--verify-max-samples")?
                 .unwrap_or(verify::PLAN_VERIFY_MAX_SAMPLES),
         )
-    } else {
-        None
     };
     let t0 = Instant::now();
-    let c = plan::compare::compare(&m, &opts, max, &|| t0.elapsed().as_secs_f64() * 1e3)?;
-    Ok(if a.has("--markdown") {
-        format!(
-            "{}\n{}\n",
-            plan::compare::Comparison::MARKDOWN_HEADER,
-            c.markdown_row(&m.name)
-        )
-    } else {
-        serde_json::to_string_pretty(&c).expect("comparison serialises") + "\n"
-    })
+    let c = plan::compare::compare(
+        &m,
+        &opts,
+        &entries,
+        Some(&mach),
+        max,
+        &|| t0.elapsed().as_secs_f64() * 1e3,
+        &mut |_| true,
+    )?;
+    if let Some(p) = a.value("--report") {
+        write_file(
+            p,
+            &(serde_json::to_string_pretty(&c).expect("comparison serialises") + "\n"),
+        )?;
+    }
+    if let Some(p) = a.value("--csv") {
+        write_file(p, &c.csv())?;
+    }
+    Ok(c.markdown())
 }
 
 fn verify_cmd(args: &[String]) -> Result<String> {

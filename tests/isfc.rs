@@ -12,7 +12,7 @@ use tspath::model::samples;
 use tspath::plan::isfc::cells::{edge, Link};
 use tspath::plan::isfc::{corner, curve, tree};
 use tspath::plan::{self, MoveKind, PlanOptions, Strategy};
-use tspath::verify::{self, CutterPath, VerifyOptions};
+use tspath::verify;
 use tspath::Model;
 
 /// The models of the loop test: two samples with holes and the two .tsm fixtures.
@@ -376,64 +376,4 @@ fn the_papers_ten_degree_incline_is_a_preset() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("gan2014"), "{e}");
-}
-
-/// `tspath compare`: both strategies on one model with the flat-surface bound; the area
-/// agrees with the cutting simulation's own quadrature, and the ratios with the lengths.
-#[test]
-fn compare_tabulates_both_strategies_against_the_flat_bound() {
-    let args = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<_>>();
-    let out = tspath::cli::run(&args(&[
-        "compare",
-        "dome",
-        "--tool-radius",
-        "1",
-        "--scallop",
-        "0.05",
-    ]))
-    .unwrap();
-    let c: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let area = c["area_mm2"].as_f64().unwrap();
-    let l_min = c["l_min_mm"].as_f64().unwrap();
-    assert!((l_min - area / (8.0f64 * 1.0 * 0.05).sqrt()).abs() < 1e-9 * l_min);
-    // The simulation's area of the same surface (its samples' quadrature).
-    let m = samples::load_sample("dome").unwrap();
-    let o = opts(1.0, 0.05);
-    let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
-    let v = verify::verify(
-        &m.surface,
-        &CutterPath::from_toolpath(&planned.toolpath).unwrap(),
-        &VerifyOptions::default()
-            .with_scallop(0.05)
-            .with_samples(100_000),
-    )
-    .unwrap();
-    assert!(
-        (area - v.area_mm2).abs() < 5e-3 * area,
-        "{area} vs {}",
-        v.area_mm2
-    );
-    let runs = c["runs"].as_array().unwrap();
-    let names: Vec<&str> = runs
-        .iter()
-        .map(|r| r["strategy"].as_str().unwrap())
-        .collect();
-    assert_eq!(names, ["isoparametric", "isfc"]);
-    for r in runs {
-        let cut = r["cutting_length_mm"].as_f64().unwrap();
-        assert!((r["cutting_over_l_min"].as_f64().unwrap() - cut / l_min).abs() < 1e-12);
-        // Curved, so longer than the flat bound; not absurdly so.
-        assert!(cut > l_min && cut < 2.0 * l_min, "{cut} mm vs {l_min} mm");
-        assert!(r["max_scallop_mm"].is_null());
-    }
-    // The curve's cutting length is the plan's (three-axis: the CLI's default machine).
-    let isfc_cut = runs[1]["cutting_length_mm"].as_f64().unwrap();
-    assert_eq!(isfc_cut, planned.report(&o).cutting_length_mm);
-    assert_eq!(runs[1]["retractions"], 0);
-    let md = tspath::cli::run(&args(&["compare", "dome", "--markdown"])).unwrap();
-    let row = md.lines().nth(2).unwrap();
-    assert!(
-        row.starts_with("| dome |") && row.matches('|').count() == 7,
-        "{row}"
-    );
 }

@@ -232,6 +232,7 @@ const STATS = [
   }],
   ['max_axis_step_deg', 'Largest tool-axis step', (r) => deg(r.max_axis_step_deg)],
   ['machining_time_min', 'Machining time', (r) => minutes(r.machining_time_min)],
+  ['feed_time_min', 'Length ÷ feed (no acceleration)', (r) => minutes(r.feed_time_min)],
   ['plan_ms', 'Planning time', (r) => ms(r.plan_ms)],
   ['verify_ms', 'Simulation time', (r, v, x) => (v ? ms(x.verify_ms) : '…')],
 ];
@@ -1064,6 +1065,9 @@ export class TspathPlanner extends HTMLElement {
       const g = await this.client.call('post', [machine, dialect, units]);
       if (plan !== this.plan) return;
       plan.gcode = { ...g, machine, dialect, units, lineStarts: null, lineCount: 0 };
+      // The machining time on this machine (the simulation's report keeps its other keys).
+      for (const r of [plan.report, plan.planReport]) Object.assign(r, g.time);
+      this.#showStats();
       this.#indexLines(plan.gcode);
       this.$('listing-title').textContent = `G-code: ${machine}, ${dialect}, ${units}`;
       this.$('p-machine').removeAttribute('aria-invalid');
@@ -1182,7 +1186,7 @@ export class TspathPlanner extends HTMLElement {
     const ctx = { ...(p.verification || {}), area_mm2: this.model.area_mm2, plain: !!p.options.isfc_plain };
     const rows = STATS.map(([id, label, f]) => [id, label, f(r, v, ctx), rawStat(id, r, v)]);
     const time = rows.find((x) => x[0] === 'machining_time_min');
-    time[1] = `Machining time at ${int(p.options.feed_mm_min ?? 1000)} mm/min`;
+    time[1] = `Machining time at ${int(p.options.feed_mm_min ?? 1000)} mm/min on ${r.time_machine} (accelerations, corners)`;
     if (r.rectangles) {
       // After the retractions: the regions and rectangles the surface was cut into.
       const at = rows.findIndex((x) => x[0] === 'retractions') + 1;

@@ -14,6 +14,7 @@ const PROGRESS_INTERVAL_MS = 40;
 let model = null; // wasm Model
 let mesh = null; // wasm SurfaceMesh of `model` (the drawn one; the heat map is per vertex of it)
 let plan = null; // wasm Plan of `model`
+let comparison = null; // wasm Comparison of `model` (its rows' plans not yet picked)
 
 function free(x) {
   if (x) x.free();
@@ -36,6 +37,48 @@ function meshArea(p, idx) {
 function drawChordal(summary) {
   const { min, max } = summary.bbox_mm;
   return Math.max(0.005, Math.hypot(max[0] - min[0], max[1] - min[1], max[2] - min[2]) * 2e-4);
+}
+
+/** A progress callback posting the fraction done under request `id`, at most every
+ * PROGRESS_INTERVAL_MS (and at the end). */
+function progressTo(id) {
+  let last = 0;
+  return (f) => {
+    const now = performance.now();
+    if (now - last >= PROGRESS_INTERVAL_MS || f >= 1) {
+      last = now;
+      postMessage({ id, progress: f });
+    }
+    return true;
+  };
+}
+
+/** The current plan as the page draws it: report, points, kinds, rest area and layers. */
+function planResult() {
+  const report = plan.report();
+  const result = {
+    report,
+    cl: plan.clPoints(),
+    cc: plan.ccPoints(),
+    axes: plan.axes(),
+    kinds: plan.moveKinds(),
+    patchIds: plan.patchIds(),
+    rest: plan.restPositions(),
+    restReasons: plan.restReasons(),
+    // A space-filling curve's cells and tree, for the layer (drawn without planning again).
+    isfc: report.strategy === 'isfc' ? {
+      cells: plan.isfcCells(), tree: plan.isfcTree(), across: plan.isfcTreeAcross(), start: plan.isfcStart(),
+    } : null,
+    // The watershed strategies' rectangles, for the layer.
+    rects: ['watershed', 'multi-rectangle'].includes(report.strategy) ? {
+      fills: plan.rectangleFills(), kinds: plan.rectangleKinds(), outlines: plan.rectangleOutlines(), arrows: plan.rectangleArrows(),
+    } : null,
+  };
+  const transfer = ['cl', 'cc', 'axes', 'kinds', 'patchIds', 'rest', 'restReasons'].map((k) => result[k].buffer);
+  for (const layer of [result.isfc, result.rects]) {
+    if (layer) transfer.push(...Object.values(layer).map((a) => a.buffer));
+  }
+  return { result, transfer };
 }
 
 const ops = {
@@ -65,6 +108,7 @@ const ops = {
         cage: next.controlEdges(),
       };
       plan = free(plan);
+      comparison = free(comparison);
       mesh = free(mesh);
       model = free(model);
       model = next;
@@ -82,40 +126,30 @@ const ops = {
   async plan(options, id) {
     if (!model) throw new Error('no model is loaded');
     plan = free(plan);
-    let last = 0;
-    const progress = (f) => {
-      const now = performance.now();
-      if (now - last >= PROGRESS_INTERVAL_MS || f >= 1) {
-        last = now;
-        postMessage({ id, progress: f });
-      }
-      return true;
-    };
-    plan = model.plan(options, progress);
-    const report = plan.report();
-    const result = {
-      report,
-      cl: plan.clPoints(),
-      cc: plan.ccPoints(),
-      axes: plan.axes(),
-      kinds: plan.moveKinds(),
-      patchIds: plan.patchIds(),
-      rest: plan.restPositions(),
-      restReasons: plan.restReasons(),
-      // A space-filling curve's cells and tree, for the layer (drawn without planning again).
-      isfc: report.strategy === 'isfc' ? {
-        cells: plan.isfcCells(), tree: plan.isfcTree(), across: plan.isfcTreeAcross(), start: plan.isfcStart(),
-      } : null,
-      // The watershed strategies' rectangles, for the layer.
-      rects: ['watershed', 'multi-rectangle'].includes(report.strategy) ? {
-        fills: plan.rectangleFills(), kinds: plan.rectangleKinds(), outlines: plan.rectangleOutlines(), arrows: plan.rectangleArrows(),
-      } : null,
-    };
-    const transfer = ['cl', 'cc', 'axes', 'kinds', 'patchIds', 'rest', 'restReasons'].map((k) => result[k].buffer);
-    for (const layer of [result.isfc, result.rects]) {
-      if (layer) transfer.push(...Object.values(layer).map((a) => a.buffer));
-    }
-    return { result, transfer };
+    plan = model.plan(options, progressTo(id));
+    return planResult();
+  },
+
+  /** Compares strategies (`strategies`: comma-separated, all when empty) on the model with
+   * `options`, times on `machine`, each cut simulated when `simulate`; the table, its CSV and
+   * each row's path for a small view. The rows' plans stay here for `pick`. */
+  async compare(options, strategies, machine, simulate, id) {
+    if (!model) throw new Error('no model is loaded');
+    comparison = free(comparison);
+    comparison = model.compare(options, strategies, machine, simulate, progressTo(id));
+    const report = comparison.report();
+    const paths = report.runs.map((_, k) => ({ cl: comparison.clPoints(k), kinds: comparison.moveKinds(k) }));
+    const result = { report, csv: comparison.csv(), paths };
+    return { result, transfer: paths.flatMap((p) => [p.cl.buffer, p.kinds.buffer]) };
+  },
+
+  /** Makes row `k` of the last comparison the current plan (as `plan` returns it). */
+  async pick(k) {
+    if (!comparison) throw new Error('nothing is compared');
+    const next = comparison.take(k);
+    plan = free(plan);
+    plan = next;
+    return planResult();
   },
 
   /** The program for a machine, dialect and units, and the line of each move in it. */
@@ -123,7 +157,10 @@ const ops = {
     if (!plan) throw new Error('nothing is planned');
     const text = plan.gcodeFor(machine, dialect, units);
     const lines = plan.gcodeLines(machine, dialect, units);
-    return { result: { text, lines }, transfer: [lines.buffer] };
+    // The machining time on the machine the program is for.
+    plan.timeOn(machine);
+    const { machining_time_min: minutes, time_machine: timeMachine, notes } = plan.report();
+    return { result: { text, lines, time: { machining_time_min: minutes, time_machine: timeMachine, notes } }, transfer: [lines.buffer] };
   },
 
   /** Cutting simulation of the plan (`options`: samples, bound_mm, max_samples): summary,

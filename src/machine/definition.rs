@@ -16,12 +16,16 @@
 //!   ],
 //!   "linear_limits_mm": {"x": [-400, 400], "y": null, "z": null},
 //!   "max_rotary_feed_deg_min": 5400,
-//!   "safe_z_machine_mm": 0
+//!   "safe_z_machine_mm": 0,
+//!   "dynamics": {"rapid_mm_min": 12000, "linear_accel_mm_s2": 1500,
+//!                "linear_jerk_mm_s3": 30000, "rotary_accel_deg_s2": 600,
+//!                "rotary_jerk_deg_s3": 12000, "junction_deviation_mm": 0.01}
 //! }
 //! ```
 //! The README's "Machines" section documents every field.
 
 use super::kinematics::{LinearLimits, Machine, Mount, Rotary};
+use super::motion::Dynamics;
 use crate::error::{Error, Result};
 use crate::geom::Vector3;
 use serde::{Deserialize, Serialize};
@@ -81,6 +85,9 @@ struct MachineFile {
     max_rotary_feed_deg_min: f64,
     #[serde(default)]
     safe_z_machine_mm: f64,
+    /// Rates and limits for the machining time; each field defaults on its own.
+    #[serde(default)]
+    dynamics: Dynamics,
 }
 
 /// A built-in machine: its name and what it is.
@@ -175,6 +182,24 @@ pub fn builtin(name: &str) -> Result<Machine> {
         ],
         _ => Vec::new(),
     };
+    // A trunnion carries the part: heavier to swing than a head, and its linear axes carry
+    // less; the defaults are a mid-size machining centre's.
+    let dynamics = match name {
+        "table-table-ac" | "table-table-bc" => Dynamics {
+            rapid_mm_min: 12_000.0,
+            linear_accel_mm_s2: 1_500.0,
+            linear_jerk_mm_s3: 30_000.0,
+            rotary_accel_deg_s2: 600.0,
+            rotary_jerk_deg_s3: 12_000.0,
+            ..Dynamics::default()
+        },
+        "head-table-bc" => Dynamics {
+            rotary_accel_deg_s2: 900.0,
+            rotary_jerk_deg_s3: 18_000.0,
+            ..Dynamics::default()
+        },
+        _ => Dynamics::default(),
+    };
     let m = Machine {
         name: info.name.to_string(),
         description: info.description.to_string(),
@@ -182,6 +207,7 @@ pub fn builtin(name: &str) -> Result<Machine> {
         linear_limits_mm: LinearLimits::default(),
         max_rotary_feed_deg_min: DEFAULT_ROTARY_FEED_DEG_MIN,
         safe_z_machine_mm: 0.0,
+        dynamics,
     };
     m.validate()?;
     Ok(m)
@@ -251,6 +277,7 @@ pub fn from_json(text: &str) -> Result<Machine> {
         },
         max_rotary_feed_deg_min: f.max_rotary_feed_deg_min,
         safe_z_machine_mm: f.safe_z_machine_mm,
+        dynamics: f.dynamics,
     };
     m.validate()?;
     Ok(m)
@@ -283,6 +310,7 @@ pub fn to_json(m: &Machine) -> String {
         }),
         max_rotary_feed_deg_min: m.max_rotary_feed_deg_min,
         safe_z_machine_mm: m.safe_z_machine_mm,
+        dynamics: m.dynamics,
     };
     serde_json::to_string_pretty(&f).expect("a machine serialises") + "\n"
 }

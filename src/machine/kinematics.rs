@@ -93,6 +93,8 @@ pub struct Machine {
     /// Machine-coordinate Z (mm) of the safe spindle position at program start and end
     /// (G53 / SUPA / M91 blocks); 0 on machines homed at the top of Z.
     pub safe_z_machine_mm: f64,
+    /// Rates, accelerations, jerk and corner rounding, for the machining time.
+    pub dynamics: super::motion::Dynamics,
 }
 
 /// Joint values of one pose: linear axes (mm) and rotary angles (degrees) in the order of
@@ -216,6 +218,12 @@ impl Machine {
                     "must be a positive number of degrees per minute, got {}",
                     self.max_rotary_feed_deg_min
                 ),
+            );
+        }
+        if let Some((name, v)) = self.dynamics.invalid_field() {
+            return bad(
+                format!("dynamics.{name}"),
+                format!("must be a positive number, got {v}"),
             );
         }
         if !self.safe_z_machine_mm.is_finite() {

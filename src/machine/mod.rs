@@ -3,7 +3,7 @@
 //!
 //! Owns: machine models and their kinematics ([`kinematics`]), machine definitions as JSON
 //! and the built-in machines ([`definition`]), joint values along a path ([`joints`]),
-//! controller dialects ([`mod@post`]), the program reader ([`reader`]) and the round-trip check
+//! controller dialects ([`mod@post`]), machining time ([`motion`]), the program reader ([`reader`]) and the round-trip check
 //! ([`roundtrip`]). Must not: plan or change the path.
 //!
 //! The one entry point the rest of the crate uses is [`post()`].
@@ -11,12 +11,14 @@
 pub mod definition;
 pub mod joints;
 pub mod kinematics;
+pub mod motion;
 pub mod post;
 pub mod reader;
 pub mod roundtrip;
 
 pub use definition::{builtin, from_json, resolve, to_json, MachineInfo, MACHINES};
 pub use kinematics::{Joints, Kinematics, Machine, Mount, Rotary, ToolPose};
+pub use motion::{path_times, Dynamics, PathTimes};
 pub use post::{Dialect, OutputMode, Posted, Units, DIALECTS};
 pub use roundtrip::{round_trip, RoundTrip};
 
@@ -51,4 +53,19 @@ pub fn post(
 pub fn gcode_3axis(path: &Toolpath, opts: &PlanOptions, job: &JobInfo) -> Result<String> {
     let machine = builtin("3-axis")?;
     post(path, opts, job, &machine, Dialect::Plain, Units::Mm)
+}
+
+/// The machine a path's default program is posted for: `3-axis` while the tool axis stays
+/// at +Z, `table-table-ac` otherwise.
+pub fn default_machine(path: &Toolpath) -> Machine {
+    let three_axis = path
+        .moves
+        .iter()
+        .all(|m| m.tool_axis == crate::geom::Vector3::z());
+    builtin(if three_axis {
+        "3-axis"
+    } else {
+        "table-table-ac"
+    })
+    .expect("the built-in machines are valid")
 }

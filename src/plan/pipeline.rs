@@ -290,6 +290,11 @@ impl Planned {
         let mut r = self
             .toolpath
             .report(self.strategy, opts.feed_mm_min, opts.plunge_feed_mm_min);
+        r.set_machining_time(
+            &self.toolpath,
+            opts,
+            &crate::machine::default_machine(&self.toolpath),
+        );
         if let Some(w) = &self.watershed {
             r.regions = w.regions.clone();
             // Each rectangle's direction and passes: its first run (the pipeline splits a

@@ -111,8 +111,15 @@ pub struct PlanReport {
     pub patch_order: Vec<PatchRun>,
     /// Things the user should know (retractions the layout forced, ...).
     pub notes: Vec<String>,
-    /// Estimated machining time at the programmed feeds, rapids at `rapid_mm_min` (min).
+    /// Machining time on `time_machine` with its accelerations, jerk and corner speeds
+    /// ([`crate::machine::motion`]) (min).
     pub machining_time_min: f64,
+    /// Length over feed: feed and link moves at the feed, plunges at the plunge feed, rapids
+    /// at `RAPID_MM_MIN` (min) — the time a machine with unlimited acceleration would take.
+    pub feed_time_min: f64,
+    /// The machine `machining_time_min` is for: the one the program is posted for, by
+    /// default `3-axis` where the tool axis stays at +Z and `table-table-ac` otherwise.
+    pub time_machine: String,
     /// Wall time of planning (ms); filled by the caller, which owns the clock.
     pub plan_ms: f64,
     /// `planned`, or `planned_with_problems` when anything in `problems` is left undone.
@@ -215,6 +222,32 @@ pub struct Problem {
 /// Rapid traverse rate assumed for time estimates (mm/min).
 pub const RAPID_MM_MIN: f64 = 5000.0;
 
+/// How the note on an approximate machining time starts.
+const TIME_NOTE: &str = "machining time:";
+
+impl PlanReport {
+    /// Sets `machining_time_min` to the time `machine` takes to run `path` at `opts`' feeds
+    /// ([`crate::machine::motion`]), naming the machine; notes where the machine cannot take
+    /// the path's tool axes and the tool axis' turn stood in for its rotaries.
+    pub fn set_machining_time(
+        &mut self,
+        path: &Toolpath,
+        opts: &super::PlanOptions,
+        machine: &crate::machine::Machine,
+    ) {
+        let t = crate::machine::path_times(path, opts, machine);
+        self.machining_time_min = t.total_min();
+        self.time_machine = machine.name.clone();
+        self.notes.retain(|n| !n.starts_with(TIME_NOTE));
+        if !t.from_joints {
+            self.notes.push(format!(
+                "{TIME_NOTE} machine `{}` cannot take every tool axis of the path, so its rotaries were timed by the tool axis' own turn",
+                machine.name
+            ));
+        }
+    }
+}
+
 impl Toolpath {
     /// Rebuilds the moves: `f(old, i, add)` adds, through `add(move, params)`, the moves
     /// that replace old move `i` (`old` holds the old moves and their params, the latter
@@ -286,6 +319,8 @@ impl Toolpath {
             patch_order: self.runs.clone(),
             notes: Vec::new(),
             machining_time_min: 0.0,
+            feed_time_min: 0.0,
+            time_machine: String::new(),
             plan_ms: 0.0,
             status: PlanStatus::Planned,
             unreachable_area_mm2: 0.0,
@@ -315,19 +350,19 @@ impl Toolpath {
             match b.kind {
                 MoveKind::Feed => {
                     r.cutting_length_mm += len;
-                    r.machining_time_min += len / feed;
+                    r.feed_time_min += len / feed;
                 }
                 MoveKind::Link => {
                     r.link_length_mm += len;
-                    r.machining_time_min += len / feed;
+                    r.feed_time_min += len / feed;
                 }
                 MoveKind::Plunge => {
                     r.link_length_mm += len;
-                    r.machining_time_min += len / plunge_feed;
+                    r.feed_time_min += len / plunge_feed;
                 }
                 MoveKind::Retract | MoveKind::Rapid => {
                     r.rapid_length_mm += len;
-                    r.machining_time_min += len / RAPID_MM_MIN;
+                    r.feed_time_min += len / RAPID_MM_MIN;
                 }
             }
             match b.kind {

@@ -210,32 +210,73 @@ impl WasmModel {
         options: JsValue,
         progress: Option<js_sys::Function>,
     ) -> Result<WasmPlan, JsError> {
-        let opts: PlanOptions = if options.is_undefined() || options.is_null() {
-            PlanOptions::default()
-        } else {
-            serde_wasm_bindgen::from_value(options)
-                .map_err(|e| JsError::new(&format!("invalid plan options: {e}")))?
-        };
+        let opts = plan_options(options)?;
         let t0 = now_ms();
-        let mut cb = |f: f64| -> bool {
-            match &progress {
-                Some(func) => func
-                    .call1(&JsValue::NULL, &JsValue::from_f64(f))
-                    .map(|r| r.as_bool() != Some(false))
-                    .unwrap_or(true),
-                None => true,
-            }
-        };
+        let mut cb = progress_callback(&progress);
         let planned = crate::plan::plan(&self.model, &opts, &mut cb).map_err(js_err)?;
         let mut report = planned.report(&opts);
         report.plan_ms = now_ms() - t0;
+        Ok(self.wasm_plan(planned, opts, report))
+    }
+
+    /// Compares strategies on this model, as `tspath compare` does: `options` as for `plan`;
+    /// `strategies` a comma-separated list (every strategy when empty or absent); `machine`
+    /// a built-in name or machine JSON text, the machine the times are for (each plan's
+    /// default when absent); `simulate` whether each cut is simulated (error bound a quarter
+    /// of the scallop). `progress` as for `plan`. Each row's plan stays in the result, to be
+    /// taken as the current plan without planning again.
+    pub fn compare(
+        &self,
+        options: JsValue,
+        strategies: Option<String>,
+        machine: Option<String>,
+        simulate: bool,
+        progress: Option<js_sys::Function>,
+    ) -> Result<WasmComparison, JsError> {
+        let opts = plan_options(options)?;
+        let entries = crate::plan::compare::Entry::parse_list(
+            strategies.as_deref().filter(|s| !s.trim().is_empty()),
+        )
+        .map_err(js_err)?;
+        let mach = machine
+            .as_deref()
+            .map(machine::resolve)
+            .transpose()
+            .map_err(js_err)?;
+        let mut cb = progress_callback(&progress);
+        let (comparison, kept) = crate::plan::compare::compare_keeping(
+            &self.model,
+            &opts,
+            &entries,
+            mach.as_ref(),
+            simulate.then_some(verify::PLAN_VERIFY_MAX_SAMPLES),
+            &now_ms,
+            &mut cb,
+        )
+        .map_err(js_err)?;
+        let plans = kept
+            .into_iter()
+            .map(|k| k.map(|(planned, o, report)| self.wasm_plan(planned, o, report)))
+            .collect();
+        Ok(WasmComparison { comparison, plans })
+    }
+}
+
+impl WasmModel {
+    /// A plan handle for JavaScript, with what its layers and the verification need.
+    fn wasm_plan(
+        &self,
+        planned: crate::plan::Planned,
+        opts: PlanOptions,
+        report: PlanReport,
+    ) -> WasmPlan {
         let rest_rects = planned.rest_rects(&self.model);
         let (rest_positions, rest_why) = planned.rest_triangles(&self.model);
         let job = JobInfo {
             model: self.model.name.clone(),
             strategy: planned.strategy.into(),
         };
-        Ok(WasmPlan {
+        WasmPlan {
             isfc_layer: planned.isfc_layer,
             watershed_layer: planned.watershed_layer,
             path: planned.toolpath,
@@ -245,6 +286,105 @@ impl WasmModel {
             rest_rects,
             rest_positions,
             rest_why,
+        }
+    }
+}
+
+/// Plan options from a plain JavaScript object (the defaults for `undefined` or `null`).
+fn plan_options(options: JsValue) -> Result<PlanOptions, JsError> {
+    if options.is_undefined() || options.is_null() {
+        Ok(PlanOptions::default())
+    } else {
+        serde_wasm_bindgen::from_value(options)
+            .map_err(|e| JsError::new(&format!("invalid plan options: {e}")))
+    }
+}
+
+/// A progress callback that calls `progress` (if given) with the fraction done; a `false`
+/// from it cancels.
+fn progress_callback(progress: &Option<js_sys::Function>) -> impl FnMut(f64) -> bool + '_ {
+    move |f: f64| -> bool {
+        match progress {
+            Some(func) => func
+                .call1(&JsValue::NULL, &JsValue::from_f64(f))
+                .map(|r| r.as_bool() != Some(false))
+                .unwrap_or(true),
+            None => true,
+        }
+    }
+}
+
+/// Strategies compared on one model: the table (as `tspath compare --report` writes it),
+/// its CSV, and each row's plan.
+#[wasm_bindgen(js_name = Comparison)]
+pub struct WasmComparison {
+    comparison: crate::plan::compare::Comparison,
+    plans: Vec<Option<WasmPlan>>,
+}
+
+#[wasm_bindgen(js_class = Comparison)]
+impl WasmComparison {
+    /// The comparison as a plain object: `model`, `tool_radius_mm`, `scallop_mm`,
+    /// `area_mm2`, `l_min_mm`, `l_min_flat_mm` and `runs` (one per strategy, with `error`
+    /// where it could not plan), the keys of `tspath compare --report`.
+    pub fn report(&self) -> Result<JsValue, JsError> {
+        to_js(&self.comparison)
+    }
+
+    /// The table as CSV, the bytes `tspath compare --csv` writes.
+    pub fn csv(&self) -> String {
+        self.comparison.csv()
+    }
+
+    /// The table as Markdown, as `tspath compare` prints it.
+    pub fn markdown(&self) -> String {
+        self.comparison.markdown()
+    }
+
+    /// Row `k`'s ball-centre points, `x y z` per move (mm; empty where it could not plan),
+    /// for a small view of its path.
+    #[wasm_bindgen(js_name = clPoints)]
+    pub fn cl_points(&self, k: usize) -> js_sys::Float32Array {
+        let pts: Vec<f32> = self
+            .plans
+            .get(k)
+            .and_then(|p| p.as_ref())
+            .map(|p| {
+                p.path
+                    .moves
+                    .iter()
+                    .flat_map(|m| m.cl_point.iter().map(|&x| x as f32).collect::<Vec<_>>())
+                    .collect()
+            })
+            .unwrap_or_default();
+        js_sys::Float32Array::from(&pts[..])
+    }
+
+    /// Row `k`'s move kinds (as `Plan.moveKinds`).
+    #[wasm_bindgen(js_name = moveKinds)]
+    pub fn move_kinds(&self, k: usize) -> js_sys::Uint8Array {
+        let kinds: Vec<u8> = self
+            .plans
+            .get(k)
+            .and_then(|p| p.as_ref())
+            .map(|p| p.path.moves.iter().map(|m| m.kind as u8).collect())
+            .unwrap_or_default();
+        js_sys::Uint8Array::from(&kinds[..])
+    }
+
+    /// Takes row `k`'s plan out (to make it the current plan); throws where the strategy
+    /// could not plan or the plan was taken already.
+    pub fn take(&mut self, k: usize) -> Result<WasmPlan, JsError> {
+        let name = self
+            .comparison
+            .runs
+            .get(k)
+            .map(|r| r.strategy.clone())
+            .ok_or_else(|| JsError::new(&format!("the comparison has no row {k}")))?;
+        self.plans.get_mut(k).and_then(Option::take).ok_or_else(|| {
+            JsError::new(&format!(
+                "{name} has no plan to take (it could not plan the model, or it was taken)"
+            ))
         })
     }
 }
@@ -462,26 +602,13 @@ impl WasmPlan {
     /// asked for, so a plan whose default program cannot be written is still a plan; throws
     /// with the machine module's reason then (see `gcodeFor` for any other choice).
     pub fn gcode(&self) -> Result<String, JsError> {
-        let three_axis = self
-            .path
-            .moves
-            .iter()
-            .all(|m| m.tool_axis == crate::geom::Vector3::z());
-        if three_axis {
-            machine::gcode_3axis(&self.path, &self.opts, &self.job)
+        let m = machine::default_machine(&self.path);
+        let dialect = if m.rotaries.is_empty() {
+            Dialect::Plain
         } else {
-            machine::builtin("table-table-ac").and_then(|m| {
-                machine::post(
-                    &self.path,
-                    &self.opts,
-                    &self.job,
-                    &m,
-                    Dialect::LinuxCnc,
-                    Units::Mm,
-                )
-            })
-        }
-        .map_err(js_err)
+            Dialect::LinuxCnc
+        };
+        machine::post(&self.path, &self.opts, &self.job, &m, dialect, Units::Mm).map_err(js_err)
     }
 
     /// The program for a machine, dialect and units: `machine` is a built-in machine name
@@ -494,6 +621,16 @@ impl WasmPlan {
         let d = Dialect::parse(dialect).map_err(js_err)?;
         let u = Units::parse(units).map_err(js_err)?;
         machine::post(&self.path, &self.opts, &self.job, &m, d, u).map_err(js_err)
+    }
+
+    /// Times the plan on `machine` (a built-in name or machine JSON text): the report's
+    /// `machining_time_min` and `time_machine` become that machine's, as `tspath plan
+    /// --machine` reports them. Throws for a machine that cannot be read.
+    #[wasm_bindgen(js_name = timeOn)]
+    pub fn time_on(&mut self, machine: &str) -> Result<(), JsError> {
+        let m = machine::resolve(machine).map_err(js_err)?;
+        self.report.set_machining_time(&self.path, &self.opts, &m);
+        Ok(())
     }
 
     /// For each move, the 1-based line of the program `gcodeFor(machine, dialect, units)`

@@ -1,0 +1,387 @@
+//! Machining time: how long a machine takes to run a path, with its rates, accelerations,
+//! jerk and corner speeds — not just length over feed.
+//!
+//! The model is a look-ahead planner of the kind CNC controllers run. Every move is a
+//! straight line in joint space (the machine's linear axes and its rotaries), as a
+//! controller interpolates it.
+//! - **Nominal speed**: a feed move takes the programmed time, `length / feed` at the tool
+//!   tip or longer where the rotaries cannot turn that fast (`turn / max_rotary_feed`, the
+//!   G93 rule of the post) or a linear axis would pass the rapid rate; a rapid moves every
+//!   joint together at the fastest rate none exceeds.
+//! - **Acceleration and jerk** along each move: the linear axes' limits scaled by how much
+//!   of the motion is linear, the rotaries' by how much turns (the tighter wins); speed
+//!   changes follow a jerk-limited S-curve (a trapezoid where jerk is unlimited).
+//! - **Corners** (junction deviation): where one move meets the next at an angle θ in joint
+//!   space (rotary degrees scaled by the ratio of linear to rotary acceleration), the
+//!   controller rounds it within `junction_deviation_mm`, which allows the corner speed
+//!   `sqrt(a δ sin(θ/2) / (1 − sin(θ/2)))`; a reversal (θ = 180°) stops, a straight
+//!   continuation keeps the feed. The machine stops between a rapid and a feed move, and
+//!   around a move that only turns.
+//! - **Look-ahead**: corner speeds are lowered until every move can reach them from the
+//!   previous one and brake to the next (backward and forward passes over the whole path).
+//!
+//! Times cover the path's moves, from its first point to its last (the program's safe
+//! start and end blocks are not part of the path).
+//!
+//! Owns: the dynamics fields of a machine and the time model. Must not: change the path or
+//! choose joint values (that is [`super::joints`]).
+
+use super::joints::{self, PoseRequest};
+use super::kinematics::Machine;
+use crate::plan::{MoveKind, PlanOptions, Toolpath};
+use serde::{Deserialize, Serialize};
+
+/// Seconds per minute.
+const S_PER_MIN: f64 = 60.0;
+/// A move shorter than this in joint space (mm, or degrees for a turn) takes no time.
+const NULL_MOVE: f64 = 1e-12;
+/// Bisection steps of the speed searches (the interval halves each step).
+const BISECTION_STEPS: usize = 60;
+
+/// What limits a machine's motion. Fields default to a mid-size machining centre.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Dynamics {
+    /// Rapid (G0) rate of the linear axes (mm/min).
+    pub rapid_mm_min: f64,
+    /// Largest acceleration of the linear axes (mm/s²): 2 000 mm/s² is about 0.2 g.
+    pub linear_accel_mm_s2: f64,
+    /// Largest jerk of the linear axes (mm/s³): how fast acceleration builds up.
+    pub linear_jerk_mm_s3: f64,
+    /// Largest angular acceleration of the rotaries (degrees/s²).
+    pub rotary_accel_deg_s2: f64,
+    /// Largest angular jerk of the rotaries (degrees/s³).
+    pub rotary_jerk_deg_s3: f64,
+    /// How far (mm) the controller may round a corner between two moves (junction
+    /// deviation, as in Grbl and Marlin; LinuxCNC's G64 P tolerance plays the same part).
+    pub junction_deviation_mm: f64,
+}
+
+impl Default for Dynamics {
+    fn default() -> Self {
+        Dynamics {
+            rapid_mm_min: 15_000.0,
+            linear_accel_mm_s2: 2_000.0,
+            linear_jerk_mm_s3: 50_000.0,
+            rotary_accel_deg_s2: 1_000.0,
+            rotary_jerk_deg_s3: 20_000.0,
+            junction_deviation_mm: 0.01,
+        }
+    }
+}
+
+impl Dynamics {
+    /// The fields that are not positive (jerk may be infinite: no jerk limit), named.
+    pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
+        [
+            ("rapid_mm_min", self.rapid_mm_min, false),
+            ("linear_accel_mm_s2", self.linear_accel_mm_s2, false),
+            ("linear_jerk_mm_s3", self.linear_jerk_mm_s3, true),
+            ("rotary_accel_deg_s2", self.rotary_accel_deg_s2, false),
+            ("rotary_jerk_deg_s3", self.rotary_jerk_deg_s3, true),
+            ("junction_deviation_mm", self.junction_deviation_mm, false),
+        ]
+        .into_iter()
+        .find(|&(_, v, may_be_infinite)| {
+            !(v > 0.0 && (v.is_finite() || (may_be_infinite && v == f64::INFINITY)))
+        })
+        .map(|(name, v, _)| (name, v))
+    }
+}
+
+/// One move as the controller runs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment {
+    /// Change of the linear axes (mm).
+    pub linear_mm: [f64; 3],
+    /// Change of the two rotaries (degrees; zero on a three-axis machine).
+    pub rotary_deg: [f64; 2],
+    /// Programmed path length at the tool tip (mm), which the feed applies to.
+    pub tip_length_mm: f64,
+    /// Programmed feed (mm/min); `None` for a rapid.
+    pub feed_mm_min: Option<f64>,
+}
+
+/// A move's motion along its own path coordinate `p` (joint-space mm, or degrees for a move
+/// that only turns): length, top speed, acceleration and jerk (per second).
+#[derive(Debug, Clone, Copy)]
+struct Profile {
+    p: f64,
+    top: f64,
+    accel: f64,
+    jerk: f64,
+    /// Path speed per unit of corner speed (joint-space speed scaled as in the corner rule).
+    to_path: f64,
+    /// Unit direction in scaled joint space (x, y, z, r1, r2), `None` for a null move.
+    dir: Option<[f64; 5]>,
+    rapid: bool,
+    /// Only turns: the machine stops before and after.
+    turn_only: bool,
+}
+
+fn profile(s: &Segment, rotary_feed_deg_min: f64, d: &Dynamics) -> Profile {
+    let lin = s.linear_mm.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let rot = s.rotary_deg[0].abs().max(s.rotary_deg[1].abs());
+    let turn_only = lin <= NULL_MOVE && rot > NULL_MOVE;
+    let p = if turn_only { rot } else { lin };
+    // Nominal time (s): the programmed one, or the joints' own rates where slower.
+    let by_joints = (lin / d.rapid_mm_min).max(rot / rotary_feed_deg_min);
+    let minutes = match s.feed_mm_min {
+        Some(f) => (s.tip_length_mm / f).max(by_joints),
+        None => by_joints,
+    };
+    let top = if minutes > 0.0 {
+        p / (minutes * S_PER_MIN)
+    } else {
+        0.0
+    };
+    // Limits along p: each joint group's limit over its share of the motion.
+    let (mut accel, mut jerk) = (f64::INFINITY, f64::INFINITY);
+    if lin > NULL_MOVE {
+        accel = accel.min(d.linear_accel_mm_s2 * p / lin);
+        jerk = jerk.min(d.linear_jerk_mm_s3 * p / lin);
+    }
+    if rot > NULL_MOVE {
+        accel = accel.min(d.rotary_accel_deg_s2 * p / rot);
+        jerk = jerk.min(d.rotary_jerk_deg_s3 * p / rot);
+    }
+    // The corner rule's space: rotary degrees as the millimetres that take the same
+    // acceleration.
+    let k = d.linear_accel_mm_s2 / d.rotary_accel_deg_s2;
+    let v = [
+        s.linear_mm[0],
+        s.linear_mm[1],
+        s.linear_mm[2],
+        s.rotary_deg[0] * k,
+        s.rotary_deg[1] * k,
+    ];
+    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let dir = (norm > NULL_MOVE && !turn_only).then(|| v.map(|x| x / norm));
+    Profile {
+        p,
+        top,
+        accel,
+        jerk,
+        to_path: if norm > NULL_MOVE { p / norm } else { 1.0 },
+        dir,
+        rapid: s.feed_mm_min.is_none(),
+        turn_only,
+    }
+}
+
+/// Time (s) and distance of a speed change from `a` to `b` under `accel` and `jerk`: the
+/// jerk-limited S-curve (constant jerk, then constant acceleration if the change is large
+/// enough, then constant jerk back to zero); its mean speed is `(a + b) / 2` by symmetry.
+fn change(a: f64, b: f64, accel: f64, jerk: f64) -> (f64, f64) {
+    let dv = (b - a).abs();
+    let t = if !jerk.is_finite() {
+        dv / accel
+    } else if dv >= accel * accel / jerk {
+        dv / accel + accel / jerk
+    } else {
+        2.0 * (dv / jerk).sqrt()
+    };
+    (t, 0.5 * (a + b) * t)
+}
+
+/// The highest speed reachable from `from` within `p` (never above `cap`).
+fn reach(from: f64, p: f64, cap: f64, accel: f64, jerk: f64) -> f64 {
+    if cap <= from || change(from, cap, accel, jerk).1 <= p {
+        return cap;
+    }
+    let (mut lo, mut hi) = (from, cap);
+    for _ in 0..BISECTION_STEPS {
+        let mid = 0.5 * (lo + hi);
+        if change(from, mid, accel, jerk).1 <= p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Time (s) of one move entered at `v0` and left at `v1` (path speeds both reachable).
+fn move_time(m: &Profile, v0: f64, v1: f64) -> f64 {
+    if m.p <= NULL_MOVE || m.top <= 0.0 {
+        return 0.0;
+    }
+    let (ta, da) = change(v0, m.top, m.accel, m.jerk);
+    let (td, dd) = change(m.top, v1, m.accel, m.jerk);
+    if da + dd <= m.p {
+        return ta + td + (m.p - da - dd) / m.top;
+    }
+    // Never reaches the top speed: the peak where speeding up and braking fill the move.
+    let (mut lo, mut hi) = (v0.max(v1), m.top);
+    for _ in 0..BISECTION_STEPS {
+        let mid = 0.5 * (lo + hi);
+        let d = change(v0, mid, m.accel, m.jerk).1 + change(mid, v1, m.accel, m.jerk).1;
+        if d <= m.p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let (ta, da) = change(v0, lo, m.accel, m.jerk);
+    let (td, dd) = change(lo, v1, m.accel, m.jerk);
+    // What the bisection leaves of the move, at the peak speed.
+    ta + td + (m.p - da - dd).max(0.0) / lo.max(f64::MIN_POSITIVE)
+}
+
+/// The corner speed (in the corner rule's scaled joint space, per second) allowed between
+/// two moves by the junction deviation.
+fn corner_speed(a: &Profile, b: &Profile, d: &Dynamics) -> f64 {
+    let (Some(u), Some(w)) = (a.dir, b.dir) else {
+        return 0.0;
+    };
+    if a.rapid != b.rapid || a.turn_only || b.turn_only {
+        return 0.0;
+    }
+    let cos = -(0..5).map(|k| u[k] * w[k]).sum::<f64>();
+    // sin(θ/2) of the corner angle θ between the reversed entry and the exit.
+    let half = (0.5 * (1.0 - cos)).max(0.0).sqrt();
+    if half >= 1.0 - 1e-12 {
+        return f64::INFINITY; // straight on
+    }
+    (d.linear_accel_mm_s2 * d.junction_deviation_mm * half / (1.0 - half)).sqrt()
+}
+
+/// Seconds each segment takes (same order), with the machine stopped before the first
+/// and after the last. `rotary_feed_deg_min` is the rotaries' fastest rate.
+pub fn segment_times(segs: &[Segment], rotary_feed_deg_min: f64, d: &Dynamics) -> Vec<f64> {
+    let n = segs.len();
+    let m: Vec<Profile> = segs
+        .iter()
+        .map(|s| profile(s, rotary_feed_deg_min, d))
+        .collect();
+    // Corner k joins move k-1 and move k, as a speed in the corner rule's space; corners 0
+    // and n are the start and end (stopped).
+    let mut w = vec![0.0; n + 1];
+    for k in 1..n {
+        let (a, b) = (&m[k - 1], &m[k]);
+        let cap_a = if a.to_path > 0.0 {
+            a.top / a.to_path
+        } else {
+            0.0
+        };
+        let cap_b = if b.to_path > 0.0 {
+            b.top / b.to_path
+        } else {
+            0.0
+        };
+        w[k] = corner_speed(a, b, d).min(cap_a).min(cap_b);
+    }
+    // Backward: every move must brake from its entry to its exit.
+    for k in (0..n).rev() {
+        let mv = &m[k];
+        if mv.p <= NULL_MOVE {
+            w[k] = w[k].min(w[k + 1]);
+            continue;
+        }
+        let exit = w[k + 1] * mv.to_path;
+        let entry = reach(exit, mv.p, w[k] * mv.to_path, mv.accel, mv.jerk);
+        w[k] = w[k].min(entry / mv.to_path);
+    }
+    // Forward: and speed up from its entry to its exit.
+    for k in 0..n {
+        let mv = &m[k];
+        if mv.p <= NULL_MOVE {
+            w[k + 1] = w[k + 1].min(w[k]);
+            continue;
+        }
+        let entry = w[k] * mv.to_path;
+        let exit = reach(entry, mv.p, w[k + 1] * mv.to_path, mv.accel, mv.jerk);
+        w[k + 1] = w[k + 1].min(exit / mv.to_path);
+    }
+    (0..n)
+        .map(|k| move_time(&m[k], w[k] * m[k].to_path, w[k + 1] * m[k].to_path))
+        .collect()
+}
+
+/// How long a path takes on a machine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathTimes {
+    /// Seconds per move: entry `i` is the motion from move `i - 1` to move `i` (entry 0 is 0).
+    pub seconds: Vec<f64>,
+    /// False where the machine cannot take the path's tool axes (a joint limit) and the
+    /// rotaries' motion was taken as the tool axis' own turn instead.
+    pub from_joints: bool,
+}
+
+impl PathTimes {
+    /// The whole path (min).
+    pub fn total_min(&self) -> f64 {
+        self.seconds.iter().sum::<f64>() / S_PER_MIN
+    }
+}
+
+/// How long `machine` takes to run `path` at `opts`' feeds (see the module documentation).
+/// The joint values are the post's ([`joints::solve`]); where the machine cannot take the
+/// path, the tool axis' turn stands in for the rotaries'.
+pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> PathTimes {
+    let r = path.tool_radius_mm;
+    let tips: Vec<crate::geom::Point3> = path
+        .moves
+        .iter()
+        .map(|m| m.cl_point - m.tool_axis * r)
+        .collect();
+    let joints = if machine.rotaries.is_empty() {
+        None
+    } else {
+        let requests: Vec<PoseRequest> = path
+            .moves
+            .iter()
+            .zip(&tips)
+            .enumerate()
+            .map(|(i, (m, t))| PoseRequest {
+                tip: *t,
+                axis: m.tool_axis,
+                starts_chain: i == 0 || m.kind == MoveKind::Rapid,
+            })
+            .collect();
+        joints::solve(machine, &requests).ok()
+    };
+    let from_joints = machine.rotaries.is_empty() || joints.is_some();
+    let segs: Vec<Segment> = (1..path.moves.len())
+        .map(|i| {
+            let (a, b) = (&path.moves[i - 1], &path.moves[i]);
+            let tip = tips[i] - tips[i - 1];
+            let (linear_mm, rotary_deg) = match &joints {
+                Some(j) => {
+                    let (p, q) = (&j[i - 1], &j[i]);
+                    (
+                        [0, 1, 2].map(|k| q.xyz_mm[k] - p.xyz_mm[k]),
+                        [0, 1].map(|k| q.rotary_deg[k] - p.rotary_deg[k]),
+                    )
+                }
+                None => {
+                    let turn = a.tool_axis.angle(&b.tool_axis).to_degrees();
+                    ([tip.x, tip.y, tip.z], [turn, 0.0])
+                }
+            };
+            Segment {
+                linear_mm,
+                rotary_deg,
+                tip_length_mm: tip.norm(),
+                feed_mm_min: match b.kind {
+                    MoveKind::Feed | MoveKind::Link => Some(opts.feed_mm_min),
+                    MoveKind::Plunge => Some(opts.plunge_feed_mm_min),
+                    MoveKind::Retract | MoveKind::Rapid => None,
+                },
+            }
+        })
+        .collect();
+    let mut seconds = Vec::with_capacity(path.moves.len());
+    if !path.moves.is_empty() {
+        seconds.push(0.0);
+    }
+    seconds.extend(segment_times(
+        &segs,
+        machine.max_rotary_feed_deg_min,
+        &machine.dynamics,
+    ));
+    PathTimes {
+        seconds,
+        from_joints,
+    }
+}
