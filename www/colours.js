@@ -24,6 +24,8 @@ export const KINDS = [
 ];
 
 export const BACKGROUND = 0xeef1f5;
+/** Ground of small drawings on the page (the comparison's paths). */
+export const BACKGROUND_LIGHT = 0xf8f9fb;
 export const EP_COLOUR = 0xffd400;
 export const CAGE_COLOUR = 0x303848;
 

@@ -15,7 +15,7 @@
 // that the parameters no longer match the plan shown (its downloads are off).
 import { CancelledError, EngineClient } from './client.js';
 import {
-  ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
+  BACKGROUND_LIGHT, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
 } from './colours.js';
 import { area, bytes, deg, int, minutes, mm, mmSig, ms, pct, share } from './format.js';
 import { GROUPS, PARAMS, byKey, flagOn, planOptions, validate } from './params.js';
@@ -69,6 +69,51 @@ const PROBLEM_KINDS = {
   gouge: 'Gouge',
   unproven: 'Not proven by the simulation',
 };
+
+/** The comparison's rows as `tspath compare` names them, with the strategy control's value
+ * each stands for and whether it is the iso-planar baseline (no deformation). */
+const COMPARE_ROWS = {
+  isoparametric: { strategy: 'isoparametric', label: 'Patch by patch (isoparametric)' },
+  isfc: { strategy: 'isfc', label: 'One continuous pass (space-filling curve)' },
+  watershed: { strategy: 'watershed', label: 'Feature regions in rectangles (watershed)' },
+  'multi-rectangle': { strategy: 'multi-rectangle', label: 'Rectangles, one direction (multi-rectangle)' },
+  isoplanar: { strategy: 'isoplanar', label: 'Parallel planes, deformed (iso-planar)' },
+  'isoplanar-baseline': { strategy: 'isoplanar', baseline: true, label: 'Parallel planes, constant spacing (iso-planar baseline)' },
+};
+
+/** The comparison table's columns: the run's key (from its simulated cut where `sim`),
+ * heading with unit, and the cell's text from the raw value. */
+const COMPARE_COLUMNS = [
+  ['cutting_length_mm', 'Cutting (mm)', (x) => x.toFixed(1)],
+  ['link_length_mm', 'Links (mm)', (x) => x.toFixed(1)],
+  ['air_length_mm', 'Air (mm)', (x) => x.toFixed(1)],
+  ['retractions', 'Retractions', int],
+  ['reversals', 'Reversals', int],
+  ['cl_points', 'CL points', int],
+  ['max_scallop_mm', 'Max scallop (mm)', (x) => x.toFixed(4), 'sim'],
+  ['mean_scallop_mm', 'Mean scallop (mm)', (x) => x.toFixed(4), 'sim'],
+  ['p95_scallop_mm', 'p95 scallop (mm)', (x) => x.toFixed(4), 'sim'],
+  ['error_bound_mm', 'Simulation bound (mm)', (x) => x.toFixed(4), 'sim'],
+  ['uncut_fraction', 'Uncut (%)', (x) => (100 * x).toFixed(2), 'sim'],
+  ['gouges', 'Gouges', int, 'sim'],
+  ['max_axis_step_deg', 'Largest axis step (°)', (x) => x.toFixed(2)],
+  ['plan_ms', 'Plan (ms)', (x) => x.toFixed(0)],
+  ['machining_time_min', 'Machining (min)', (x) => x.toFixed(2)],
+  ['feed_time_min', 'Length ÷ feed (min)', (x) => x.toFixed(2)],
+  ['efficiency', 'Cutting ÷ L_min', (x) => x.toFixed(3)],
+  ['efficiency_flat', 'Cutting ÷ flat L_min', (x) => x.toFixed(3)],
+];
+
+/** The bar charts under the table: key, title with unit, decimals. */
+const COMPARE_CHARTS = [
+  ['machining_time_min', 'Machining time (min)', 2],
+  ['cutting_length_mm', 'Cutting length (mm)', 0],
+  ['reversals', 'Reversals', 0],
+  ['max_scallop_mm', 'Max simulated scallop (mm)', 4],
+];
+
+/** A run's value for a column key (from its simulated cut where the column says so). */
+const runValue = (run, key, fromSim) => (fromSim ? run.simulated?.[key] : run[key]);
 
 /** The layers a plan of some strategies brings along (drawn without planning again), each
  * with its view setter, legend heading, box titles and legend rows (`[colour, text, filled]`). */
@@ -124,6 +169,7 @@ const TEMPLATE = `
   <div class="stage">
     <div class="toolbar">
       <button id="plan" type="button" class="primary">Plan tool path</button>
+      <button id="compare" type="button" title="Plan every strategy on this model with these settings, simulate each cut and put them side by side">Compare strategies</button>
       <button id="cancel" type="button" disabled>Cancel</button>
       <label class="inline" title="Re-plan after each change when planning takes under ${AUTO_REPLAN_MS / 1000} s">
         <input id="auto" type="checkbox" checked> Re-plan on change when fast</label>
@@ -160,6 +206,18 @@ const TEMPLATE = `
       <output id="tool-readout" for="scrub">no path yet</output>
     </div>
     <div id="path-legend" class="legend path-legend" aria-label="Path colours"></div>
+    <section id="compare-panel" class="compare-panel" hidden aria-labelledby="compare-title">
+      <div class="compare-head">
+        <h2 id="compare-title">Strategies compared</h2>
+        <label class="inline" title="Simulate each strategy's cut until the error bound is a quarter of the scallop (as tspath compare does); off: plans only, much faster"><input type="checkbox" id="compare-simulate" checked> Simulate each cut</label>
+        <button id="compare-csv" type="button" disabled>Download CSV</button>
+        <button id="compare-close" type="button">Close</button>
+      </div>
+      <p id="compare-summary" class="hint"></p>
+      <div class="compare-table-wrap"><table id="compare-table" aria-describedby="compare-summary"></table></div>
+      <div id="compare-charts" class="compare-charts" aria-label="Bar charts of the comparison"></div>
+      <div id="compare-thumbs" class="compare-thumbs" aria-label="Each strategy's path, seen from above"></div>
+    </section>
   </div>
   <aside class="results" aria-label="Results">
     <section class="stats-section" id="stats-section">
@@ -271,7 +329,7 @@ function download(name, data, type) {
 
 export class TspathPlanner extends HTMLElement {
   static get observedAttributes() {
-    return ['model', ...PARAMS.map((p) => p.key)];
+    return ['model', 'compare', ...PARAMS.map((p) => p.key)];
   }
 
   constructor() {
@@ -301,6 +359,10 @@ export class TspathPlanner extends HTMLElement {
     if (!this.ready || old === value) return;
     if (name === 'model') {
       if (value && value !== this.$('sample').value) this.#loadNamed(value);
+      return;
+    }
+    if (name === 'compare') {
+      if (flagOn(value ?? '0')) this.#compare();
       return;
     }
     if (!this.$(`p-${name}`)) return;
@@ -391,10 +453,9 @@ export class TspathPlanner extends HTMLElement {
     this.#validateAll();
     const model = initial.model || info.samples[0];
     const loaded = await this.#loadNamed(model);
-    const planFlag = initial.plan;
-    if (loaded && planFlag !== undefined && planFlag !== null && planFlag !== '0' && planFlag !== 'false') {
-      this.#plan();
-    }
+    const flag = (x) => x !== undefined && x !== null && x !== '0' && x !== 'false';
+    if (loaded && flag(initial.plan)) await this.#plan();
+    if (loaded && flag(initial.compare)) this.#compare();
   }
 
   async #createView() {
@@ -493,6 +554,20 @@ export class TspathPlanner extends HTMLElement {
     const $ = this.$;
     $('plan').addEventListener('click', () => this.#plan());
     $('cancel').addEventListener('click', () => this.#cancel());
+    $('compare').addEventListener('click', () => this.#compare());
+    $('compare-close').addEventListener('click', () => {
+      $('compare-panel').hidden = true;
+      this.comparison = null;
+      this.#syncUrl();
+    });
+    $('compare-csv').addEventListener('click', () => {
+      if (this.comparison) download(`${this.#baseName()}-compare.csv`, new Blob([this.comparison.csv], { type: 'text/csv' }));
+    });
+    // A row's strategy button or its path picks it.
+    $('compare-panel').addEventListener('click', (e) => {
+      const b = e.target.closest('button[data-row]');
+      if (b) this.#pickCompared(Number(b.dataset.row));
+    });
     $('sample').addEventListener('change', () => this.#loadNamed($('sample').value));
     $('file').addEventListener('change', () => {
       const f = $('file').files[0];
@@ -618,6 +693,9 @@ export class TspathPlanner extends HTMLElement {
     const sample = source.sample ?? pub?.id ?? null;
     this.model = { ...m, sample, file: source.sample ? null : label, pub };
     this.#clearPlan();
+    // A comparison is of the model it was made on.
+    this.comparison = null;
+    this.#showComparison();
     this.$('colour-patches').checked = true;
     this.$('sample').value = sample ?? '';
     this.#showSummary(m.summary, pub);
@@ -820,6 +898,7 @@ export class TspathPlanner extends HTMLElement {
     }
     const list = Object.values(errors);
     this.$('plan').disabled = list.length > 0 || !this.model || this.planning;
+    this.$('compare').disabled = list.length > 0 || !this.model || this.planning;
     return list.length ? { errors: list } : { values };
   }
 
@@ -965,14 +1044,20 @@ export class TspathPlanner extends HTMLElement {
       return;
     }
     if (token !== this.planToken) return;
+    await this.#adopt(result, options, v.values, t0);
+  }
+
+  /** Makes a planned result (from `plan`, or a compared row from `pick`) the plan shown:
+   * path, layers, statistics, program, URL, then its simulation. */
+  async #adopt(result, options, values, t0) {
     this.#clearPlan();
     // `report` is what the page shows: the plan's own (`planReport`), and once simulated
     // the same with the simulation's findings added.
-    this.plan = { ...result, planReport: result.report, options, values: v.values, workerHasPlan: true };
+    this.plan = { ...result, planReport: result.report, options, values, workerHasPlan: true };
     this.view.setPath(result);
     this.#showRest();
     for (const key of Object.keys(OVERLAYS)) this.#showOverlay(key);
-    this.#showTool(v.values);
+    this.#showTool(values);
     const n = result.kinds.length;
     const scrub = this.$('scrub');
     scrub.max = String(Math.max(0, n - 1));
@@ -998,6 +1083,275 @@ export class TspathPlanner extends HTMLElement {
       return;
     }
     this.#verify();
+  }
+
+  // ---------------------------------------------------------------- comparison
+
+  /** Plans every strategy with the settings shown, in the worker (progress, Cancel), each
+   * cut simulated unless asked not to, and shows them side by side. */
+  async #compare() {
+    clearTimeout(this.replanTimer);
+    if (!this.model || !this.ready) return;
+    const v = this.#validateAll();
+    if (v.errors) {
+      this.#status(v.errors[0], true);
+      return;
+    }
+    if (this.planning) {
+      this.#status('Wait for the plan to finish (or cancel it), then compare.', 'warning');
+      return;
+    }
+    const options = this.#planOptions(v.values);
+    const simulate = this.$('compare-simulate').checked;
+    const token = (this.planToken = (this.planToken || 0) + 1);
+    this.planning = true;
+    this.#stopPlay();
+    this.state = 'comparing';
+    this.$('plan').disabled = true;
+    this.$('compare').disabled = true;
+    this.$('cancel').disabled = false;
+    const bar = this.$('progress');
+    bar.hidden = false;
+    bar.value = 0;
+    const t0 = performance.now();
+    // When progress arrived (ms from the start), for the benchmark's "every 250 ms".
+    this.compareTicks = [];
+    this.#status('Comparing strategies… 0 %');
+    let result;
+    try {
+      result = await this.client.call('compare', [options, '', v.values.machine, simulate], (f) => {
+        if (token !== this.planToken) return;
+        this.compareTicks.push(performance.now() - t0);
+        bar.value = f;
+        this.#status(`Comparing strategies… ${Math.round(100 * f)} % (${((performance.now() - t0) / 1000).toFixed(1)} s)`);
+      });
+    } catch (e) {
+      if (token !== this.planToken) return;
+      this.#endPlanning();
+      if (e instanceof CancelledError) return;
+      this.state = this.plan ? 'planned' : 'model-loaded';
+      this.#status(`Could not compare: ${e.message}`, true);
+      this.#markField(e.message);
+      return;
+    }
+    if (token !== this.planToken) return;
+    this.#endPlanning();
+    this.state = this.plan ? 'planned' : 'model-loaded';
+    const elapsed = performance.now() - t0;
+    this.comparison = { ...result, options, values: v.values, simulate, ms: elapsed, current: null };
+    this.#showComparison();
+    const runs = result.report.runs;
+    const failed = runs.filter((r) => r.error).length;
+    const problems = runs.filter((r) => !r.error && r.status === 'planned_with_problems').length;
+    const tail = [failed && `${failed} could not plan`, problems && `${problems} planned with problems`].filter(Boolean).join(', ');
+    this.#status(`Compared ${runs.length} strategies in ${(elapsed / 1000).toFixed(1)} s${tail ? `: ${tail} (see the table)` : ''}. Pick a row to make it the plan shown.`, tail ? 'warning' : '');
+    this.dataset.compared = String(Number(this.dataset.compared || 0) + 1);
+    this.#syncUrl();
+  }
+
+  /** The comparison panel: summary, table, bar charts and each path from above. */
+  #showComparison() {
+    const c = this.comparison;
+    const panel = this.$('compare-panel');
+    panel.hidden = !c;
+    if (!c) return;
+    const r = c.report;
+    this.$('compare-csv').disabled = false;
+    this.$('compare-summary').textContent = `${r.model}: ball radius ${mmSig(r.tool_radius_mm)}, scallop ${mmSig(r.scallop_mm)}, times on ${c.values.machine}; surface ${area(r.area_mm2)}, L_min ${mm(r.l_min_mm, 1)} (∫ dA / g, the side step of the better principal direction at each point) and ${mm(r.l_min_flat_mm, 1)} flat (area / √(8 r h)). ${c.simulate ? 'Each cut simulated until its error bound is a quarter of the scallop.' : 'Not simulated.'} Planned in ${(c.ms / 1000).toFixed(1)} s. Pick a strategy (its name or its path) to make it the plan shown.`;
+    // The table.
+    const table = this.$('compare-table');
+    table.replaceChildren();
+    const head = table.createTHead().insertRow();
+    for (const h of ['Strategy', ...COMPARE_COLUMNS.map((x) => x[1]), 'Status']) {
+      const th = document.createElement('th');
+      th.scope = 'col';
+      th.textContent = h;
+      head.append(th);
+    }
+    const body = table.createTBody();
+    r.runs.forEach((run, k) => {
+      const tr = body.insertRow();
+      tr.dataset.strategy = run.strategy;
+      tr.classList.toggle('current', c.current === k);
+      const th = document.createElement('th');
+      th.scope = 'row';
+      const b = document.createElement('button');
+      b.type = 'button';
+      b.textContent = run.strategy;
+      b.title = run.error ? `${COMPARE_ROWS[run.strategy]?.label}: could not plan this model` : `${COMPARE_ROWS[run.strategy]?.label}: make it the plan shown`;
+      b.dataset.row = String(k);
+      b.disabled = !!run.error;
+      th.append(b);
+      tr.append(th);
+      if (run.error) {
+        const td = tr.insertCell();
+        td.colSpan = COMPARE_COLUMNS.length;
+        td.className = 'reason';
+        td.textContent = `Could not plan: ${run.error}`;
+      } else {
+        for (const [key, , f, sim] of COMPARE_COLUMNS) {
+          const td = tr.insertCell();
+          const x = runValue(run, key, sim);
+          td.dataset.key = key;
+          if (x === undefined || x === null) {
+            td.textContent = '–';
+          } else {
+            td.dataset.value = String(x);
+            td.textContent = f(x);
+          }
+        }
+      }
+      const st = tr.insertCell();
+      st.className = run.error || run.status === 'planned_with_problems' ? 'warning' : '';
+      st.textContent = run.error ? 'could not plan' : run.status === 'planned' ? 'planned' : `planned with problems: ${run.problems.join(', ')}`;
+    });
+    this.#drawCompareCharts();
+    this.#drawCompareThumbs();
+  }
+
+  /** Horizontal bar charts of the planned rows (SVG): time, length, reversals, scallop (with
+   * the requested scallop marked). */
+  #drawCompareCharts() {
+    const c = this.comparison;
+    const box = this.$('compare-charts');
+    box.replaceChildren();
+    const runs = c.report.runs.filter((r) => !r.error);
+    const NS = 'http://www.w3.org/2000/svg';
+    const el = (name, attrs, text) => {
+      const e = document.createElementNS(NS, name);
+      for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, String(v));
+      if (text !== undefined) e.textContent = text;
+      return e;
+    };
+    const [W, LABEL, ROW] = [300, 118, 16];
+    for (const [key, title, digits] of COMPARE_CHARTS) {
+      const sim = key === 'max_scallop_mm';
+      const vals = runs.map((r) => runValue(r, key, sim));
+      if (vals.some((x) => x === undefined || x === null)) continue;
+      const mark = sim ? c.report.scallop_mm : null;
+      const top = Math.max(...vals, mark || 0) || 1;
+      const figure = document.createElement('figure');
+      figure.dataset.chart = key;
+      const cap = document.createElement('figcaption');
+      cap.textContent = title;
+      const h = ROW * runs.length + 4;
+      const svg = el('svg', { viewBox: `0 0 ${W} ${h}`, width: W, height: h, role: 'img', 'aria-label': `${title}: ${runs.map((r, i) => `${r.strategy} ${vals[i].toFixed(digits)}`).join(', ')}` });
+      const span = W - LABEL - 52;
+      runs.forEach((r, i) => {
+        const y = i * ROW + 2;
+        svg.append(el('text', { x: LABEL - 4, y: y + 11, 'text-anchor': 'end', class: 'label' }, r.strategy));
+        const w = Math.max(1, (span * vals[i]) / top);
+        const over = mark !== null && vals[i] > mark;
+        svg.append(el('rect', { x: LABEL, y, width: w, height: ROW - 4, class: over ? 'bar over' : 'bar', 'data-value': vals[i] }));
+        svg.append(el('text', { x: LABEL + w + 3, y: y + 11, class: 'value' }, vals[i].toFixed(digits)));
+      });
+      if (mark !== null) {
+        const x = LABEL + (span * mark) / top;
+        svg.append(el('line', { x1: x, x2: x, y1: 0, y2: h, class: 'mark' }));
+        svg.append(el('title', {}, `requested scallop ${mark} mm`));
+      }
+      figure.append(cap, svg);
+      box.append(figure);
+    }
+  }
+
+  /** Each row's path from above on one scale, in a button that picks it. */
+  #drawCompareThumbs() {
+    const c = this.comparison;
+    const box = this.$('compare-thumbs');
+    box.replaceChildren();
+    const lo = [Infinity, Infinity];
+    const hi = [-Infinity, -Infinity];
+    for (const p of c.paths) {
+      for (let i = 0; i < p.cl.length; i += 3) {
+        for (let k = 0; k < 2; k++) {
+          lo[k] = Math.min(lo[k], p.cl[i + k]);
+          hi[k] = Math.max(hi[k], p.cl[i + k]);
+        }
+      }
+    }
+    const [W, H, PAD] = [190, 140, 6];
+    const scale = Math.min((W - 2 * PAD) / Math.max(hi[0] - lo[0], 1e-9), (H - 2 * PAD) / Math.max(hi[1] - lo[1], 1e-9));
+    c.report.runs.forEach((run, k) => {
+      const b = document.createElement('button');
+      b.type = 'button';
+      b.className = 'thumb';
+      b.dataset.row = String(k);
+      b.disabled = !!run.error;
+      b.classList.toggle('current', c.current === k);
+      b.setAttribute('aria-label', run.error ? `${run.strategy}: could not plan` : `${run.strategy}: make it the plan shown`);
+      const canvas = document.createElement('canvas');
+      canvas.width = W;
+      canvas.height = H;
+      const ctx = canvas.getContext('2d');
+      ctx.fillStyle = hexCss(BACKGROUND_LIGHT);
+      ctx.fillRect(0, 0, W, H);
+      const { cl, kinds } = c.paths[k];
+      const x = (i) => PAD + (cl[3 * i] - lo[0]) * scale;
+      const y = (i) => H - PAD - (cl[3 * i + 1] - lo[1]) * scale;
+      // Cuts and links dark, air moves red: one path per colour.
+      for (const [which, colour, width] of [[(kk) => kk <= 1 || kk === 4, 0x1f3b73, 0.6], [(kk) => kk === 2 || kk === 3, 0xd62728, 0.8]]) {
+        ctx.strokeStyle = hexCss(colour);
+        ctx.lineWidth = width;
+        ctx.beginPath();
+        for (let i = 1; i < kinds.length; i++) {
+          if (!which(kinds[i])) continue;
+          ctx.moveTo(x(i - 1), y(i - 1));
+          ctx.lineTo(x(i), y(i));
+        }
+        ctx.stroke();
+      }
+      const cap = document.createElement('span');
+      cap.textContent = run.error ? `${run.strategy}: could not plan` : `${run.strategy}: ${minutes(run.machining_time_min)}, ${int(run.retractions)} retractions`;
+      b.append(canvas, cap);
+      box.append(b);
+    });
+  }
+
+  /** Makes compared row `k` the plan shown: the controls take its strategy, and the worker
+   * its plan (planned again where the worker no longer holds it, after a cancel). */
+  async #pickCompared(k) {
+    const c = this.comparison;
+    const run = c?.report.runs[k];
+    if (!run || run.error || this.planning) return;
+    const row = COMPARE_ROWS[run.strategy];
+    this.#setControl(byKey.strategy, row.strategy);
+    this.#setControl(byKey['no-deform'], row.baseline ? '1' : '0');
+    this.#updateDependentControls();
+    const v = this.#validateAll();
+    if (v.errors) {
+      this.#status(v.errors[0], true);
+      return;
+    }
+    const options = this.#planOptions(v.values);
+    const token = (this.planToken = (this.planToken || 0) + 1);
+    this.planning = true;
+    this.#stopPlay();
+    let result;
+    try {
+      result = await this.client.call('pick', [k]);
+    } catch (e) {
+      if (token !== this.planToken) return;
+      this.#endPlanning();
+      if (e instanceof CancelledError) return;
+      // Taken already or lost with a restarted worker: the same options plan the same path.
+      this.#plan();
+      c.current = k;
+      this.#markCurrentRow();
+      return;
+    }
+    if (token !== this.planToken) return;
+    c.current = k;
+    this.#markCurrentRow();
+    await this.#adopt(result, options, v.values, performance.now() - run.plan_ms);
+  }
+
+  #markCurrentRow() {
+    const c = this.comparison;
+    for (const el of this.$('compare-panel').querySelectorAll('tbody tr, button.thumb')) {
+      const k = el.matches('tr') ? [...el.parentNode.children].indexOf(el) : Number(el.dataset.row);
+      el.classList.toggle('current', c?.current === k);
+    }
   }
 
   #endPlanning() {
@@ -1028,7 +1382,7 @@ export class TspathPlanner extends HTMLElement {
     if (wasPlanning) {
       this.#endPlanning();
       this.state = this.plan ? 'planned' : 'model-loaded';
-      if (!quiet) this.#status('Planning cancelled.');
+      if (!quiet) this.#status(this.state === 'comparing' ? 'Comparison cancelled.' : 'Planning cancelled.');
     } else if (this.dataset.verify === 'running') {
       this.dataset.verify = 'cancelled';
       this.$('cancel').disabled = true;
@@ -1554,8 +1908,8 @@ export class TspathPlanner extends HTMLElement {
     }
   }
 
-  /** With `sync-url`: the sample and every parameter not at its default, and `plan=1` once
-   * planned, so the link opens the same plan. */
+  /** With `sync-url`: the sample and every parameter not at its default, `plan=1` once
+   * planned and `compare=1` while a comparison is shown, so the link opens the same. */
   #syncUrl() {
     if (!this.hasAttribute('sync-url') || !this.ready) return;
     const q = new URLSearchParams();
@@ -1567,6 +1921,7 @@ export class TspathPlanner extends HTMLElement {
       if (v !== '' && v !== d && !(p.kind === 'number' && Number(v) === Number(d) && d !== '')) q.set(p.key, v);
     }
     if (this.plan) q.set('plan', '1');
+    if (this.comparison) q.set('compare', '1');
     const query = q.toString().replace(/%2F/g, '/'); // `model=grapetec/Bike.tsm` reads better
     const url = `${location.pathname}${query ? `?${query}` : ''}${location.hash}`;
     if (url !== `${location.pathname}${location.search}${location.hash}`) history.replaceState(null, '', url);

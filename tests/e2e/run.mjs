@@ -1213,6 +1213,76 @@ test('without WebGL the 2D view draws the cells and tree', async (page, url) => 
   return `${px} px`;
 }, { noWebGL: true });
 
+test('compare: bumps-hole, every strategy side by side as tspath compare has it; a row becomes the plan shown; the CSV downloads', async (page, url) => {
+  const args = ['compare', 'bumps-hole', '--tool-radius', '1', '--scallop', '0.01', '--report', 'cmp.json', '--csv', 'cmp.csv'];
+  // The CLI runs beside the browser.
+  const cliDone = new Promise((resolve, reject) => {
+    execFile(cli, args, { cwd: work, maxBuffer: 1 << 26 }, (err) => (err ? reject(err) : resolve()));
+  });
+  await page.goto(`${url}?model=bumps-hole&tool-radius=1&scallop=0.01&compare=1&${SIM}`);
+  await page.waitForSelector(`${HOST}[data-compared="1"]`, { timeout: 240000, state: 'attached' });
+  const ticks = await host(page, (el) => el.compareTicks);
+  await cliDone;
+  const c = JSON.parse(readFileSync(join(work, 'cmp.json'), 'utf8'));
+  const rows = await host(page, (el) => [...el.shadowRoot.querySelectorAll('#compare-table tbody tr')].map((tr) => ({
+    strategy: tr.dataset.strategy,
+    reason: tr.querySelector('td.reason')?.textContent ?? null,
+    cells: Object.fromEntries([...tr.querySelectorAll('td[data-key]')].map((td) => [td.dataset.key, td.dataset.value === undefined ? null : Number(td.dataset.value)])),
+  })));
+  check(rows.length === 6 && rows.every((r, k) => r.strategy === c.runs[k].strategy), `rows: ${rows.map((r) => r.strategy)}`);
+  // Every number the CLI has (planning time aside): bit-equal, or within 1e-9 where wasm's
+  // floating point differs in the last digits.
+  let numbers = 0;
+  let exact = 0;
+  let worst = 0;
+  rows.forEach((row, k) => {
+    const run = c.runs[k];
+    check((row.reason === null) === (run.error === null), `${run.strategy}: a reason where the CLI has one (${row.reason})`);
+    if (run.error) return;
+    for (const [key, v] of Object.entries(row.cells)) {
+      if (key === 'plan_ms') continue;
+      const want = ['max_scallop_mm', 'mean_scallop_mm', 'p95_scallop_mm', 'error_bound_mm', 'uncut_fraction', 'gouges'].includes(key) ? run.simulated[key] : run[key];
+      numbers++;
+      if (v === want) exact++;
+      const d = Math.abs(v - want) / Math.max(1e-12, Math.abs(want));
+      worst = Math.max(worst, d);
+      check(d <= 1e-9, `${run.strategy} ${key}: page ${v}, CLI ${want}`);
+    }
+  });
+  const planned = c.runs.filter((r) => !r.error).length;
+  check(planned === 6 && c.runs.every((r) => r.error || (r.simulated.max_scallop_mm <= c.scallop_mm + r.simulated.error_bound_mm && r.simulated.gouges === 0)), 'all six planned, each within the scallop and its bound, no gouge');
+  // The charts and the paths.
+  const charts = await host(page, (el) => [...el.shadowRoot.querySelectorAll('#compare-charts figure')].map((f) => f.dataset.chart));
+  check(charts.join() === 'machining_time_min,cutting_length_mm,reversals,max_scallop_mm', `charts: ${charts}`);
+  const thumbs = await host(page, (el) => el.shadowRoot.querySelectorAll('#compare-thumbs canvas').length);
+  check(thumbs === 6, `${thumbs} small views`);
+  // The CSV: the CLI's, the planning time column aside.
+  const csv = (await downloadText(page, '#compare-csv')).bytes.toString('utf8');
+  const cliCsv = readFileSync(join(work, 'cmp.csv'), 'utf8');
+  const table = (t) => t.split('\r\n').filter(Boolean).map((l) => l.split(','));
+  const [mine, theirs] = [table(csv), table(cliCsv)];
+  const planCol = theirs[0].indexOf('plan (ms)');
+  const same = mine.length === theirs.length && mine.every((row, i) => row.every((f, j) => j === planCol || f === theirs[i][j]));
+  check(planCol > 0 && same, `the CSV is the CLI's but for the planning time:\n${csv}\nvs\n${cliCsv}`);
+  check(new URL(page.url()).searchParams.get('compare') === '1', `the URL keeps the comparison: ${page.url()}`);
+  await page.screenshot({ path: join(shots, 'compare-bumps-hole.png'), fullPage: true });
+  // A row becomes the plan shown: the controls say its strategy, the path is drawn.
+  const k = c.runs.findIndex((r) => r.strategy === 'isoplanar-baseline');
+  await page.click(`#compare-table tbody tr[data-strategy="isoplanar-baseline"] th button`);
+  await waitPlans(page, 1);
+  const r = await host(page, (el) => el.plan.planReport);
+  const controls = await host(page, (el) => [el.shadowRoot.getElementById('p-strategy').value, el.shadowRoot.getElementById('p-no-deform').checked]);
+  check(r.strategy === 'isoplanar' && r.cl_points === c.runs[k].cl_points && r.retractions === c.runs[k].retractions, `the baseline's plan is shown: ${r.strategy}, ${r.cl_points} CL points (row ${c.runs[k].cl_points})`);
+  check(controls[0] === 'isoplanar' && controls[1] === true, `the controls say it: ${controls}`);
+  check((await attr(page, 'data-stale')) === null, 'the plan shown is the controls\' plan');
+  const px = await host(page, (el) => el.layerPixels('path'));
+  check(px > 1000, `its path is drawn (${px} px)`);
+  const current = await host(page, (el) => el.shadowRoot.querySelector('#compare-table tr.current')?.dataset.strategy);
+  check(current === 'isoplanar-baseline', `the row is marked current: ${current}`);
+  const gaps = ticks.slice(1).map((t, i) => t - ticks[i]);
+  return `6 rows; ${exact} of ${numbers} numbers bit-equal to the CLI (largest relative difference ${worst.toExponential(1)}); compared in ${(ticks[ticks.length - 1] / 1000).toFixed(1)} s, ${ticks.length} progress updates, longest gap ${Math.round(Math.max(...gaps))} ms; picked row drawn (${px} px)`;
+});
+
 test('without WebGL the 2D view draws the regions and rectangles', async (page, url) => {
   await page.goto(`${url}?model=bumps&strategy=watershed&tool-radius=1&scallop=0.05&${SIM}&plan=1`);
   await waitPlans(page, 1);
