@@ -183,3 +183,34 @@ fn a_strategy_list_is_read_and_a_wrong_name_is_named() {
         .to_string();
     assert!(err.contains("--strategies"), "{err}");
 }
+
+/// Progress goes one way, ends at 1, and moves while each cut is simulated (not only when
+/// each strategy ends).
+#[test]
+fn progress_is_monotone_and_covers_the_simulations() {
+    let m = samples::load_sample("dome").unwrap();
+    let o = PlanOptions::default()
+        .with_tool_radius(1.0)
+        .with_scallop(0.05);
+    let entries = Entry::parse_list(Some("isoparametric,isfc")).unwrap();
+    let mut seen: Vec<f64> = Vec::new();
+    let c = compare::compare(&m, &o, &entries, None, Some(1_000_000), &|| 0.0, &mut |f| {
+        seen.push(f);
+        true
+    })
+    .unwrap();
+    assert_eq!(c.runs.len(), 2);
+    assert!(seen.windows(2).all(|w| w[1] >= w[0]), "{seen:?}");
+    assert_eq!(*seen.last().unwrap(), 1.0);
+    // Inside each entry's simulation part (after its 60 % of planning).
+    for k in 0..2 {
+        let (lo, hi) = ((k as f64 + 0.6) / 2.0, (k as f64 + 1.0) / 2.0);
+        assert!(
+            seen.iter().any(|&f| f > lo && f < hi),
+            "entry {k}: nothing between {lo} and {hi}: {seen:?}"
+        );
+    }
+    // Cancelling stops the comparison with the error that says so.
+    let e = compare::compare(&m, &o, &entries, None, None, &|| 0.0, &mut |f| f < 0.3).unwrap_err();
+    assert!(matches!(e, tspath::Error::Cancelled), "{e}");
+}

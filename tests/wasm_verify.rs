@@ -26,7 +26,9 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     let mesh = model.tessellate(0.01).unwrap();
     let vopts = js_sys::Object::new();
     js_sys::Reflect::set(&vopts, &"samples".into(), &50_000.into()).unwrap();
-    let v = model.verify(&plan, &mesh, vopts.clone().into()).unwrap();
+    let v = model
+        .verify(&plan, &mesh, vopts.clone().into(), None)
+        .unwrap();
     let s = v.summary().unwrap();
     for key in [
         "max_scallop_mm",
@@ -76,7 +78,7 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
     let bounded = js_sys::Object::new();
     js_sys::Reflect::set(&bounded, &"samples".into(), &20_000.into()).unwrap();
     js_sys::Reflect::set(&bounded, &"bound_mm".into(), &0.004.into()).unwrap();
-    let b = model.verify(&plan, &mesh, bounded.into()).unwrap();
+    let b = model.verify(&plan, &mesh, bounded.into(), None).unwrap();
     let bs = b.summary().unwrap();
     assert!(get(&bs, "error_bound_mm").as_f64().unwrap() <= 0.004);
     assert!(get(&bs, "samples").as_f64().unwrap() > 20_000.0);
@@ -89,7 +91,7 @@ fn plan_verifies_with_a_heat_map_per_vertex() {
 
     let bad = js_sys::Object::new();
     js_sys::Reflect::set(&bad, &"samples".into(), &2.into()).unwrap();
-    let msg = js_message(model.verify(&plan, &mesh, bad.into()).err().unwrap());
+    let msg = js_message(model.verify(&plan, &mesh, bad.into(), None).err().unwrap());
     assert!(msg.contains("samples"), "{msg}");
     let msg = js_message(
         model

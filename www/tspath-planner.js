@@ -1477,9 +1477,24 @@ export class TspathPlanner extends HTMLElement {
     const start = values.samples;
     const bound = plan.options.scallop_mm * VERIFY_BOUND_SHARE;
     const cap = values['max-samples'];
-    this.#planStatus(` Simulating the cut (from ${int(start)} samples until its error bound is ${mm(bound, 4)}, at most ${int(cap)} samples)…`);
+    const what = ` Simulating the cut (from ${int(start)} samples until its error bound is ${mm(bound, 4)}, at most ${int(cap)} samples)…`;
+    this.#planStatus(what);
+    const bar = this.$('progress');
+    const t0 = performance.now();
+    const done = () => {
+      if (!this.planning) bar.hidden = true;
+    };
     try {
-      const v = await this.client.call('verify', [{ samples: start, bound_mm: bound, max_samples: cap }]);
+      const v = await this.client.call('verify', [{ samples: start, bound_mm: bound, max_samples: cap }], (f) => {
+        if (token !== this.verifyToken || plan !== this.plan || this.planning) return;
+        bar.hidden = false;
+        bar.value = f;
+        // Progress, unless an error is being shown (it stays until the user acts).
+        if (!this.$('status').classList.contains('error')) {
+          this.#planStatus(`${what} ${Math.round(100 * f)} % (${((performance.now() - t0) / 1000).toFixed(1)} s)`);
+        }
+      });
+      done();
       if (token !== this.verifyToken || plan !== this.plan) return;
       plan.verification = { ...v, samples: start };
       plan.report = v.report;
@@ -1490,6 +1505,7 @@ export class TspathPlanner extends HTMLElement {
       this.#showColours();
       if (!this.hasAttribute('data-stale') && !this.$('status').classList.contains('error')) this.#planStatus();
     } catch (e) {
+      done();
       if (token !== this.verifyToken || e instanceof CancelledError) return;
       this.dataset.verify = 'error';
       this.#status(`The cutting simulation failed: ${e.message}`, true);

@@ -165,9 +165,9 @@ const ops = {
 
   /** Cutting simulation of the plan (`options`: samples, bound_mm, max_samples): summary,
    * the heat map per drawn vertex, and the plan's report with what it found. */
-  async verify(options) {
+  async verify(options, id) {
     if (!plan) throw new Error('nothing is planned');
-    const v = model.verify(plan, mesh, options);
+    const v = model.verify(plan, mesh, options, progressTo(id));
     try {
       const result = {
         summary: v.summary(), heat: v.heatMap(), verify_ms: v.verifyMs, report: plan.reportWith(v),

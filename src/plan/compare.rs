@@ -25,7 +25,8 @@ use serde::{Deserialize, Serialize};
 const AREA_CELLS: usize = 64;
 /// First sample count of a simulation, before it is raised towards its bound.
 const FIRST_SAMPLES: usize = 200_000;
-/// Share of a strategy's progress its planning takes (the simulation takes the rest).
+/// Share of a strategy's progress its planning takes when its cut is simulated (the
+/// simulation takes the rest).
 const PLAN_SHARE: f64 = 0.6;
 
 /// A row of the comparison: a strategy with the options it adds.
@@ -271,7 +272,8 @@ pub fn compare_keeping(
     for (k, entry) in entries.iter().enumerate() {
         let base = k as f64 / n;
         let o = entry.options(opts);
-        let mut sub = |f: f64| progress(base + PLAN_SHARE * f / n);
+        // `f`: the fraction of this entry done.
+        let mut sub = |f: f64| progress(base + f / n);
         let run = match run_one(
             model,
             &o,
@@ -343,7 +345,13 @@ fn run_one(
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<(StrategyRun, Kept)> {
     let t0 = clock();
-    let planned = plan(model, o, progress)?;
+    // Planning takes the whole entry, or its share where the cut is simulated after.
+    let plan_share = if verify_max_samples.is_some() {
+        PLAN_SHARE
+    } else {
+        1.0
+    };
+    let planned = plan(model, o, &mut |f| progress(f * plan_share))?;
     let mut report = planned.report(o);
     report.plan_ms = clock() - t0;
     if let Some(m) = machine {
@@ -352,7 +360,17 @@ fn run_one(
     let plan_report = report.clone();
     let simulated = match verify_max_samples {
         Some(max) => {
-            let v = verify::verify_plan(model, &planned, o, Some(FIRST_SAMPLES.min(max)), max)?;
+            let mut tell = |f: f64| {
+                progress(PLAN_SHARE + (1.0 - PLAN_SHARE) * f);
+            };
+            let v = verify::verify_plan_progress(
+                model,
+                &planned,
+                o,
+                Some(FIRST_SAMPLES.min(max)),
+                max,
+                &mut tell,
+            )?;
             report.add_verification(&v);
             Some(SimulatedCut {
                 max_scallop_mm: v.max_scallop_mm,

@@ -730,6 +730,7 @@ fn run_items(
     ctx: &Ctx,
     items: &[(usize, usize, usize, bool)],
     heat: Option<&mut HeatMap>,
+    progress: &mut dyn FnMut(f64),
 ) -> Vec<Acc> {
     let workers = threads(ctx.opts.threads).min(items.len()).max(1);
     let new_probe = || {
@@ -744,9 +745,15 @@ fn run_items(
     if workers == 1 {
         let mut probe = new_probe();
         let mut heat = heat;
+        let n = items.len().max(1) as f64;
         return items
             .iter()
-            .map(|&(fi, j0, j1, own)| band(ctx, &mut probe, fi, j0, j1, own, heat.as_deref_mut()))
+            .enumerate()
+            .map(|(k, &(fi, j0, j1, own))| {
+                let acc = band(ctx, &mut probe, fi, j0, j1, own, heat.as_deref_mut());
+                progress((k + 1) as f64 / n);
+                acc
+            })
             .collect();
     }
     #[cfg(target_arch = "wasm32")]
@@ -789,6 +796,9 @@ fn run_items(
                 h.merge(&m);
             }
         }
+        // The threads report nothing on the way (only wasm, single-threaded, has a page to
+        // show progress on).
+        progress(1.0);
         results
             .into_inner()
             .expect("no worker panics")
@@ -839,11 +849,13 @@ fn summarise(patch: u32, grid: [usize; 2], acc: &Acc) -> PatchVerification {
     }
 }
 
+/// Simulates the cut; `progress` gets the fraction of the sample bands done.
 pub(super) fn run(
     surface: &Surface,
     path: &CutterPath,
     opts: &VerifyOptions,
     mut heat: Option<&mut HeatMap>,
+    progress: &mut dyn FnMut(f64),
 ) -> Verification {
     let r = path.tool_radius_mm;
     let reach = r;
@@ -854,8 +866,11 @@ pub(super) fn run(
         min: bbox.min.map(|x| x - grow),
         max: bbox.max.map(|x| x + grow),
     };
+    progress(0.0);
     let index = CapsuleIndex::build(&capsules, r, &region, CELL_PER_RADIUS * r);
+    progress(0.0);
     let grids = grids(surface, opts.samples);
+    progress(0.0);
     let rest = RestMask::new(&opts.rest_area, grids.len());
     let mut ctx = Ctx {
         surface,
@@ -876,7 +891,7 @@ pub(super) fn run(
         ToolSide::Auto => vote_side(&ctx, &mut probe),
     };
     let items = work_items(&grids);
-    let results = run_items(&ctx, &items, heat.as_deref_mut());
+    let results = run_items(&ctx, &items, heat.as_deref_mut(), progress);
     let mut per_face: Vec<Acc> = vec![Acc::default(); grids.len()];
     for (&(fi, ..), acc) in items.iter().zip(results) {
         per_face[fi].merge(acc);

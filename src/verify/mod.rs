@@ -134,16 +134,29 @@ pub fn verify_plan(
     samples: Option<usize>,
     max_samples: usize,
 ) -> Result<Verification> {
+    verify_plan_progress(model, planned, opts, samples, max_samples, &mut |_| {})
+}
+
+/// As [`verify_plan`], telling `progress` the fraction done on the way.
+pub fn verify_plan_progress(
+    model: &Model,
+    planned: &Planned,
+    opts: &PlanOptions,
+    samples: Option<usize>,
+    max_samples: usize,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Verification> {
     let mut vo = plan_options(opts, planned.rest_rects(model));
     if let Some(n) = samples {
         vo = vo.with_samples(n);
     }
-    verify_to_bound_within(
+    verify_to_bound_progress(
         &model.surface,
         &CutterPath::from_toolpath(&planned.toolpath)?,
         &vo,
         PLAN_BOUND_SHARE * opts.scallop_mm,
         max_samples,
+        progress,
     )
 }
 
@@ -316,7 +329,7 @@ pub struct Verification {
 /// Simulates `path` over `surface` and measures what it leaves.
 pub fn verify(surface: &Surface, path: &CutterPath, opts: &VerifyOptions) -> Result<Verification> {
     opts.validate()?;
-    Ok(engine::run(surface, path, opts, None))
+    Ok(engine::run(surface, path, opts, None, &mut |_| {}))
 }
 
 /// Most rounds of [`verify_to_bound`].
@@ -348,10 +361,33 @@ pub fn verify_to_bound_within(
     target_mm: f64,
     max_samples: usize,
 ) -> Result<Verification> {
+    verify_to_bound_progress(surface, path, opts, target_mm, max_samples, &mut |_| {})
+}
+
+/// As [`verify_to_bound_within`], telling `progress` the fraction done on the way (each
+/// round takes half of what is left, as the rounds needed are not known beforehand).
+pub fn verify_to_bound_progress(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    target_mm: f64,
+    max_samples: usize,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Verification> {
     let first = first_samples(surface, path, opts);
-    bound_rounds(opts, first, target_mm, max_samples, &mut |o| {
-        verify(surface, path, o)
+    bound_rounds(opts, first, target_mm, max_samples, &mut |o, round| {
+        o.validate()?;
+        Ok(engine::run(surface, path, o, None, &mut |f| {
+            progress(round_progress(round, f))
+        }))
     })
+}
+
+/// Overall progress of round `round` (from 0) done to `f`: round k spans
+/// `[1 − 2^−k, 1 − 2^−(k+1)]`.
+fn round_progress(round: usize, f: f64) -> f64 {
+    let start = 1.0 - 0.5f64.powi(round as i32);
+    start + f * 0.5f64.powi(round as i32 + 1)
 }
 
 /// As [`verify_to_bound`] with at most `max_samples` samples, and the heat map of the last
@@ -363,11 +399,14 @@ pub fn verify_to_bound_with_heat_map(
     target_mm: f64,
     max_samples: usize,
     mesh: &Tessellation,
+    progress: &mut dyn FnMut(f64),
 ) -> Result<(Verification, Vec<f32>)> {
     let mut heat = Vec::new();
     let first = first_samples(surface, path, opts);
-    let v = bound_rounds(opts, first, target_mm, max_samples, &mut |o| {
-        let (v, h) = verify_with_heat_map(surface, path, o, mesh)?;
+    let v = bound_rounds(opts, first, target_mm, max_samples, &mut |o, round| {
+        let (v, h) = verify_with_heat_map_progress(surface, path, o, mesh, &mut |f| {
+            progress(round_progress(round, f))
+        })?;
         heat = h;
         Ok(v)
     })?;
@@ -400,7 +439,7 @@ fn bound_rounds(
     first: usize,
     target_mm: f64,
     max_samples: usize,
-    run: &mut dyn FnMut(&VerifyOptions) -> Result<Verification>,
+    run: &mut dyn FnMut(&VerifyOptions, usize) -> Result<Verification>,
 ) -> Result<Verification> {
     if !(target_mm.is_finite() && target_mm > 0.0) {
         return Err(Error::param(
@@ -411,14 +450,14 @@ fn bound_rounds(
     let cap = max_samples.clamp(MIN_SAMPLES, MAX_SAMPLES);
     let mut o = opts.clone();
     o.samples = o.samples.max(first).min(cap);
-    let mut v = run(&o)?;
-    for _ in 1..BOUND_ROUNDS {
+    let mut v = run(&o, 0)?;
+    for round in 1..BOUND_ROUNDS {
         if v.error_bound_mm <= target_mm || o.samples >= cap {
             break;
         }
         let grow = (v.error_bound_mm / target_mm * BOUND_SAFETY).clamp(1.5, BOUND_MAX_GROWTH);
         o.samples = ((o.samples as f64 * grow).ceil() as usize).min(cap);
-        v = run(&o)?;
+        v = run(&o, round)?;
     }
     v.error_bound_target_mm = Some(target_mm);
     Ok(v)
@@ -434,6 +473,17 @@ pub fn verify_with_heat_map(
     opts: &VerifyOptions,
     mesh: &Tessellation,
 ) -> Result<(Verification, Vec<f32>)> {
+    verify_with_heat_map_progress(surface, path, opts, mesh, &mut |_| {})
+}
+
+/// As [`verify_with_heat_map`], telling `progress` the fraction done on the way.
+pub fn verify_with_heat_map_progress(
+    surface: &Surface,
+    path: &CutterPath,
+    opts: &VerifyOptions,
+    mesh: &Tessellation,
+    progress: &mut dyn FnMut(f64),
+) -> Result<(Verification, Vec<f32>)> {
     opts.validate()?;
     if mesh.positions.len() % 3 != 0 || mesh.indices.len() != 3 * mesh.patch_ids.len() {
         return Err(Error::param(
@@ -442,6 +492,6 @@ pub fn verify_with_heat_map(
         ));
     }
     let mut map = heatmap::HeatMap::new(mesh);
-    let v = engine::run(surface, path, opts, Some(&mut map));
+    let v = engine::run(surface, path, opts, Some(&mut map), progress);
     Ok((v, map.into_values()))
 }

@@ -728,18 +728,24 @@ impl WasmModel {
     /// the scallop defaults to the plan's, the gouge tolerance to its chordal tolerance or
     /// 0.002 mm, whichever is smaller, and the plan's rest area is measured apart. With
     /// `bound_mm` the sample count grows from `samples` (to at most `max_samples`, default
-    /// 8 000 000) until the error bound is within it.
+    /// 8 000 000) until the error bound is within it. `progress`, if given, is called with
+    /// the fraction done (its answer is ignored: the page cancels by stopping the worker).
     pub fn verify(
         &self,
         plan: &WasmPlan,
         mesh: &WasmMesh,
         options: JsValue,
+        progress: Option<js_sys::Function>,
     ) -> Result<WasmVerification, JsError> {
         let (bound, max_samples) = bound_options(&options)?;
         let base = verify::plan_options(&plan.opts, plan.rest_rects.clone());
         let opts = verify_options(base, options)?;
         let path = CutterPath::from_toolpath(&plan.path).map_err(js_err)?;
         let t0 = now_ms();
+        let mut cb = progress_callback(&progress);
+        let mut report = |f: f64| {
+            cb(f);
+        };
         let (summary, heat) = match bound {
             Some(b) => verify::verify_to_bound_with_heat_map(
                 &self.model.surface,
@@ -748,8 +754,15 @@ impl WasmModel {
                 b,
                 max_samples,
                 &mesh.mesh,
+                &mut report,
             ),
-            None => verify::verify_with_heat_map(&self.model.surface, &path, &opts, &mesh.mesh),
+            None => verify::verify_with_heat_map_progress(
+                &self.model.surface,
+                &path,
+                &opts,
+                &mesh.mesh,
+                &mut report,
+            ),
         }
         .map_err(js_err)?;
         Ok(WasmVerification {

@@ -77,6 +77,8 @@ const BOUNDARY_JOIN_REL: f64 = 1e-7;
 const THIN_SHARE: f64 = 0.5;
 /// Most slice points one chord may stand for when thinning.
 const THIN_LOOKAHEAD: usize = 64;
+/// Share of the slicing's progress the pass checks take (after 0.6 of it).
+const CHECK_PROGRESS_SHARE: f64 = 0.3;
 /// Share of the progress bar the slicing takes (the pipeline the rest).
 const DRAFT_SHARE: f64 = 0.5;
 
@@ -346,7 +348,15 @@ pub fn slices(
     let mut gap = step;
     let mut predicted: f64 = 0.0;
     for round in 0..=MAX_SPLITS {
-        let (needs, worst) = too_wide(model, opts, &frame, &passes, gap);
+        // Each round's check reports over its share of 0.6 to 0.9.
+        let span = CHECK_PROGRESS_SHARE / (MAX_SPLITS + 1) as f64;
+        let lo = 0.6 + span * round as f64;
+        let (needs, worst) = too_wide(model, opts, &frame, &passes, gap, &mut |f| {
+            progress(lo + span * f);
+        });
+        if !progress(lo + span) {
+            return Err(Error::Cancelled);
+        }
         predicted = predicted.max(worst);
         if needs.is_empty() {
             break;
@@ -710,6 +720,7 @@ fn too_wide(
     frame: &Frame,
     passes: &[Pass],
     gap: f64,
+    tick: &mut dyn FnMut(f64),
 ) -> (Vec<(f64, Vec<Point3>, f64)>, f64) {
     let r = opts.tool_radius_mm;
     let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
@@ -721,7 +732,9 @@ fn too_wide(
         segments: Vec<(Point3, Point3)>,
     }
     let mut planes: Vec<Plane> = Vec::new();
-    for p in passes {
+    let n_passes = passes.len().max(1) as f64;
+    for (k, p) in passes.iter().enumerate() {
+        tick(0.5 * k as f64 / n_passes);
         if planes.last().is_none_or(|x| x.c != p.plane) {
             planes.push(Plane {
                 c: p.plane,
@@ -768,7 +781,9 @@ fn too_wide(
     let reach = CHECK_REACH_SPACINGS * (8.0 * r * h).sqrt();
     let mut out = Vec::new();
     let mut worst_ok: f64 = 0.0;
-    for w in planes.windows(2) {
+    let n_pairs = planes.len().max(2) as f64 - 1.0;
+    for (k, w) in planes.windows(2).enumerate() {
+        tick(0.5 + 0.5 * k as f64 / n_pairs);
         let (a, b) = (&w[0], &w[1]);
         if (b.c - a.c - gap).abs() > 1e-6 * gap.max(1.0) {
             continue;
