@@ -3,6 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::machine::{self, Dialect, JobInfo, Units};
+use crate::model::setup::{ImportSetup, LengthUnit, Up};
 use crate::model::{samples, Model};
 use crate::plan::{self, PlanOptions, Strategy};
 use crate::verify::{self, CutterPath, VerifyOptions};
@@ -38,7 +39,11 @@ const USAGE: &str = "usage:
   tspath machine NAME [-o FILE.json]
   tspath verify MODEL GCODE_OR_TOOLPATH --tool-radius MM [--samples N] [--bound MM]
               [--scallop MM] [--gouge-tolerance MM] [--machine NAME|FILE.json] [--dialect NAME]
-MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample.
+MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample. Every command
+that reads a MODEL places it with [--model-units mm|cm|m|inch] (the unit of a file that
+does not say its own, OBJ; default mm) [--scale F] [--up z|y] (y: the file's +Y becomes +Z,
+as modelling tools write) [--rotate 0|90|180|270] (about +Z, counter-clockwise from above)
+[--on-table] (lowest point at Z 0); `info` shows the placement and the millimetre box.
 --axis-preset gan2014 leads the tool 10° from the surface normal along the feed, as the
 space-filling-curve paper machined (five-axis machines); --lead/--tilt after it override.
 --machine is a built-in machine (default 3-axis) or a machine JSON file (start from
@@ -93,14 +98,19 @@ pub fn run_with_status(args: &[String]) -> Result<(String, Status)> {
 
 /// Loads a model file, or a built-in sample when no file of that name exists.
 pub fn load_model(arg: &str) -> Result<Model> {
+    load_model_with(arg, &ImportSetup::default())
+}
+
+/// As [`load_model`], placed by `setup`.
+pub fn load_model_with(arg: &str, setup: &ImportSetup) -> Result<Model> {
     let path = std::path::Path::new(arg);
     if path.exists() {
         let bytes =
             std::fs::read(path).map_err(|e| Error::Io(format!("cannot read {arg}: {e}")))?;
         let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("model");
-        crate::io::load(&bytes, stem)
+        crate::io::load_with(&bytes, stem, setup)
     } else if samples::SAMPLES.iter().any(|s| s.name == arg) {
-        samples::load_sample(arg)
+        samples::load_sample_with(arg, setup)
     } else {
         Err(Error::Io(format!(
             "{arg}: no such file, and not a built-in sample (see `tspath sample --list`)"
@@ -177,11 +187,11 @@ fn write_file(path: &str, text: &str) -> Result<()> {
 }
 
 fn info(args: &[String]) -> Result<String> {
-    let a = parse(args, &[], &[])?;
+    let a = parse(args, SETUP_FLAGS, SETUP_SWITCHES)?;
     let [model] = a.positional[..] else {
         return Err(Error::Io(format!("info takes one MODEL\n{USAGE}")));
     };
-    let m = load_model(model)?;
+    let m = load_model_with(model, &import_setup(&a)?)?;
     let mut s = serde_json::to_string_pretty(&m.summary()).expect("summary serialises");
     s.push('\n');
     Ok(s)
@@ -209,7 +219,11 @@ fn sample(args: &[String]) -> Result<String> {
 }
 
 fn export(args: &[String]) -> Result<String> {
-    let a = parse(args, &["-o", "--chordal"], &[])?;
+    let a = parse(
+        args,
+        &[SETUP_FLAGS, &["-o", "--chordal"]].concat(),
+        SETUP_SWITCHES,
+    )?;
     let [model] = a.positional[..] else {
         return Err(Error::Io(format!("export takes one MODEL\n{USAGE}")));
     };
@@ -223,7 +237,7 @@ fn export(args: &[String]) -> Result<String> {
             format!("must be a positive number of mm, got {chordal}"),
         ));
     }
-    let m = load_model(model)?;
+    let m = load_model_with(model, &import_setup(&a)?)?;
     let t = m.tessellate(chordal);
     let lower = out.to_ascii_lowercase();
     if lower.ends_with(".stl") {
@@ -244,11 +258,54 @@ fn export(args: &[String]) -> Result<String> {
     ))
 }
 
+/// The model set-up flags every command that reads a model takes.
+const SETUP_FLAGS: &[&str] = &["--model-units", "--scale", "--up", "--rotate"];
+const SETUP_SWITCHES: &[&str] = &["--on-table"];
+
+/// The model set-up the flags ask for.
+fn import_setup(a: &Args) -> Result<ImportSetup> {
+    let mut s = ImportSetup {
+        strict_units: true,
+        ..ImportSetup::default()
+    };
+    if let Some(u) = a.value("--model-units") {
+        s.model_units = Some(LengthUnit::parse(u)?);
+    }
+    if let Some(v) = a.number("--scale")? {
+        s.scale = v;
+    }
+    if let Some(u) = a.value("--up") {
+        s.up = Up::parse(u)?;
+    }
+    if let Some(v) = a.number("--rotate")? {
+        let turn = v.rem_euclid(360.0);
+        if turn.fract() != 0.0 || turn as u32 % 90 != 0 {
+            return Err(Error::Io(format!(
+                "--rotate: `{v}` is not a quarter turn; use 0, 90, 180 or 270 (degrees, counter-clockwise seen from above)"
+            )));
+        }
+        s.rotate_deg = turn as u32;
+    }
+    s.on_table = a.has("--on-table");
+    s.validate()?;
+    Ok(s)
+}
+
 /// Options `plan` and `compare` take.
 /// The plan's switches (flags without a value).
-const PLAN_SWITCHES: &[&str] = &["--verify", "--isfc-plain", "--no-deform", "--shear"];
+const PLAN_SWITCHES: &[&str] = &[
+    "--verify",
+    "--isfc-plain",
+    "--no-deform",
+    "--shear",
+    "--on-table",
+];
 
 const PLAN_FLAGS: &[&str] = &[
+    "--model-units",
+    "--scale",
+    "--up",
+    "--rotate",
     "--slice-angle",
     "--tool-radius",
     "--scallop",
@@ -281,7 +338,7 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
             "plan and compare take one MODEL\n{USAGE}"
         )));
     };
-    let m = load_model(model)?;
+    let m = load_model_with(model, &import_setup(a)?)?;
     let mach = load_machine(a.value("--machine").unwrap_or("3-axis"))?;
     let mut opts = PlanOptions::default();
     if let Some(v) = a.number("--tool-radius")? {
@@ -479,8 +536,12 @@ fn verify_cmd(args: &[String]) -> Result<String> {
             "--gouge-tolerance",
             "--machine",
             "--dialect",
+            "--model-units",
+            "--scale",
+            "--up",
+            "--rotate",
         ],
-        &[],
+        SETUP_SWITCHES,
     )?;
     let [model, path_file] = a.positional[..] else {
         return Err(Error::Io(format!(
@@ -492,7 +553,7 @@ fn verify_cmd(args: &[String]) -> Result<String> {
             "verify needs --tool-radius MM (the ball-end radius)\n{USAGE}"
         )));
     };
-    let m = load_model(model)?;
+    let m = load_model_with(model, &import_setup(&a)?)?;
     let text = std::fs::read_to_string(path_file)
         .map_err(|e| Error::Io(format!("cannot read {path_file}: {e}")))?;
     let (path, mut opts) = if text.trim_start().starts_with('{') {

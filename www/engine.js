@@ -24,12 +24,16 @@ export async function engineInfo() {
   };
 }
 
-/** A built-in sample model (a handle in wasm memory; call free() when done). */
-export async function loadSample(name) {
-  return (await loadEngine()).Model.sample(name);
+/** A built-in sample model (a handle in wasm memory; call free() when done), placed by
+ * `setup` if given (see Model.fromBytesPlaced). */
+export async function loadSample(name, setup = null) {
+  const w = await loadEngine();
+  return setup ? w.Model.samplePlaced(name, setup) : w.Model.sample(name);
 }
 
-/** A model from file bytes; throws an Error whose message says what is wrong with the file. */
-export async function loadBytes(bytes, name) {
-  return (await loadEngine()).Model.fromBytes(bytes, name);
+/** A model from file bytes, placed by `setup` if given; throws an Error whose message says
+ * what is wrong with the file. */
+export async function loadBytes(bytes, name, setup = null) {
+  const w = await loadEngine();
+  return setup ? w.Model.fromBytesPlaced(bytes, name, setup) : w.Model.fromBytes(bytes, name);
 }

@@ -11,6 +11,13 @@
  * field is its negation.
  */
 export const PARAMS = [
+  // Placement of the model (not plan options: the model is read again with them). As the
+  // CLI's --model-units, --scale, --up, --rotate and --on-table.
+  { key: 'model-units', field: null, group: 'placement', placement: true, label: 'File\u2019s unit (for files that do not say: OBJ)', kind: 'choice', choices: [['', 'as the file says (OBJ: mm)'], ['mm', 'millimetres'], ['cm', 'centimetres'], ['m', 'metres'], ['inch', 'inches']], default: '' },
+  { key: 'scale', field: null, group: 'placement', placement: true, label: 'Scale', unit: '×', kind: 'number', min: 0.000001, max: 1000000, step: 0.1, default: 1 },
+  { key: 'up', field: null, group: 'placement', placement: true, label: 'The file\u2019s up axis', kind: 'choice', choices: [['z', '+Z (machines)'], ['y', '+Y (most modelling tools): turned to +Z']], default: 'z' },
+  { key: 'rotate', field: null, group: 'placement', placement: true, label: 'Turn about Z (counter-clockwise from above)', unit: '°', kind: 'choice', choices: [['0', '0°'], ['90', '90°'], ['180', '180°'], ['270', '270°']], default: '0' },
+  { key: 'on-table', field: null, group: 'placement', placement: true, label: 'Lowest point on the table (Z 0)', kind: 'flag', default: false },
   // Strategy
   { key: 'strategy', field: 'strategy', group: 'strategy', label: 'How the surface is cut', kind: 'choice', choices: [['isoparametric', 'Patch by patch (isoparametric)'], ['isfc', 'One continuous pass (space-filling curve)'], ['watershed', 'Feature regions in rectangles (watershed)'], ['multi-rectangle', 'Rectangles, one direction (multi-rectangle)'], ['isoplanar', 'Parallel planes (iso-planar, deformed CL surface)']], default: 'isoparametric' },
   { key: 'isfc-plain', field: 'isfc_plain', group: 'strategy', label: 'Plain curve: the paper\u2019s baseline, without the parity repair and the corner compensation', kind: 'flag', default: false, isfcOnly: true },
@@ -54,6 +61,7 @@ export const PARAMS = [
 ];
 
 export const GROUPS = [
+  ['placement', 'Placement of the model'],
   ['accuracy', 'Accuracy'],
   ['strategy', 'Strategy'],
   ['tool', 'Tool, shank and holder'],
@@ -161,4 +169,18 @@ export function planOptions(values, { fiveAxis, paperLeadDeg = 10 }) {
     o.tilt_deg = 0;
   }
   return o;
+}
+
+/** The model placement the values ask for (Model.fromBytesPlaced's `setup`), or null when
+ * it changes nothing. */
+export function placement(values) {
+  const s = {
+    model_units: values['model-units'] || null,
+    scale: Number(values.scale ?? 1),
+    up: values.up || 'z',
+    rotate_deg: Number(values.rotate || 0),
+    on_table: !!values['on-table'],
+  };
+  const identity = !s.model_units && s.scale === 1 && s.up === 'z' && s.rotate_deg === 0 && !s.on_table;
+  return identity ? null : s;
 }

@@ -18,7 +18,7 @@ import {
   BACKGROUND_LIGHT, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
 } from './colours.js';
 import { area, bytes, deg, int, minutes, mm, mmSig, ms, pct, share } from './format.js';
-import { GROUPS, PARAMS, byKey, flagOn, planOptions, validate } from './params.js';
+import { GROUPS, PARAMS, byKey, flagOn, placement, planOptions, validate } from './params.js';
 
 /** Plans faster than this (ms, planning and posting) are redone on every change. */
 const AUTO_REPLAN_MS = 1500;
@@ -625,6 +625,17 @@ export class TspathPlanner extends HTMLElement {
 
   // ---------------------------------------------------------------- models
 
+  /** Reads the model shown again (after a change of its placement). */
+  async #reload() {
+    const m = this.model;
+    if (!m) return false;
+    if (m.pub) return this.#loadPublic(m.pub);
+    if (m.sample) return this.#loadNamed(m.sample);
+    const src = this.client.source;
+    if (!src?.bytes) return false;
+    return this.#load({ bytes: src.bytes.slice(0), name: src.name }, m.file);
+  }
+
   /** Loads a built-in sample or one of the public files by its picker name. */
   async #loadNamed(name) {
     const pub = publicModel(name);
@@ -678,6 +689,11 @@ export class TspathPlanner extends HTMLElement {
    * the bytes are, if one. */
   async #load(source, label, pub = null) {
     if (this.planning || this.dataset.verify === 'running') this.#cancel(true);
+    // Placed as the placement controls say (when valid; else as modelled, and the field says
+    // what is wrong).
+    const placed = validate(this.#raw(), { patches: 1, fiveAxis: this.#fiveAxis });
+    const bad = PARAMS.filter((p) => p.placement && placed.errors[p.key]);
+    source = { ...source, setup: bad.length ? null : placement(placed.values) };
     this.state = 'loading';
     this.#status(`Loading ${label}…`);
     let m;
@@ -712,8 +728,9 @@ export class TspathPlanner extends HTMLElement {
     this.dataset.meshChordalMm = String(m.chordal_mm);
     const { errors } = this.#validateAll();
     // A wrong value from the URL or an attribute is said at once, not only at its field.
-    if (errors) this.#status(`Loaded ${m.summary.name}: ${m.summary.patches} patches. Before planning: ${errors[0]}`, true);
-    else this.#status(`Loaded ${m.summary.name}: ${m.summary.patches} patches. Choose parameters and plan.`);
+    const patches = `${int(m.summary.patches)} ${m.summary.patches === 1 ? 'patch' : 'patches'}`;
+    if (errors) this.#status(`Loaded ${m.summary.name}: ${patches}. Before planning: ${errors[0]}`, true);
+    else this.#status(`Loaded ${m.summary.name}: ${patches}. Choose parameters and plan.`);
     this.#syncUrl();
     return true;
   }
@@ -725,6 +742,7 @@ export class TspathPlanner extends HTMLElement {
       ['Name', s.name],
       ['Format', s.format + (s.units_read && s.units_read !== 'mm' ? ` (${s.units_read})` : '')],
       ['Size (mm)', size.map((v) => v.toFixed(v < 10 ? 2 : 1)).join(' × ')],
+      ['Placement', s.placement],
       ['Faces', int(s.faces)],
       ['Control points', int(s.control_points)],
       ['Patches', int(s.patches)],
@@ -907,6 +925,19 @@ export class TspathPlanner extends HTMLElement {
     const sel = this.$(`p-${key}`);
     if (sel && sel.tagName === 'SELECT') {
       for (const o of [...sel.options]) if (o.dataset.unknown && o.value !== sel.value) o.remove();
+    }
+    if (byKey[key]?.placement) {
+      // The model is read again, placed anew (the plan, made on the old placement, goes).
+      this.#validateAll();
+      this.#syncUrl();
+      const { errors } = validate(this.#raw(), { patches: 1, fiveAxis: this.#fiveAxis });
+      const bad = PARAMS.find((p) => p.placement && errors[p.key]);
+      if (bad) {
+        this.#status(errors[bad.key], true);
+        return;
+      }
+      this.#reload();
+      return;
     }
     if (key === 'machine' || key === 'strategy' || key === 'axis-preset') this.#updateDependentControls();
     if (key === 'tool-radius') this.#concaveHint();

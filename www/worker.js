@@ -89,8 +89,8 @@ const ops = {
   /** Loads a sample ({sample}) or file bytes ({bytes, name}); the old model stays on failure. */
   async load(source) {
     const next = source.sample !== undefined
-      ? await loadSample(source.sample)
-      : await loadBytes(new Uint8Array(source.bytes), source.name);
+      ? await loadSample(source.sample, source.setup)
+      : await loadBytes(new Uint8Array(source.bytes), source.name, source.setup);
     let nextMesh = null;
     try {
       const summary = next.summary();

@@ -11,6 +11,7 @@ pub mod obj;
 pub mod tsm;
 
 use crate::error::{Error, Result};
+use crate::model::setup::ImportSetup;
 use crate::model::Model;
 
 /// Model file formats the readers know.
@@ -67,6 +68,13 @@ pub fn detect(bytes: &[u8]) -> Result<Format> {
 /// Reads a model from bytes, format detected from the content. `name` is used when the
 /// file carries no name of its own.
 pub fn load(bytes: &[u8], name: &str) -> Result<Model> {
+    load_with(bytes, name, &ImportSetup::default())
+}
+
+/// As [`load`], the model placed by `setup` (unit for files that do not say, scale, up
+/// axis, turn, on the table).
+pub fn load_with(bytes: &[u8], name: &str, setup: &ImportSetup) -> Result<Model> {
+    setup.validate()?;
     match detect(bytes)? {
         Format::Json => {
             let text = std::str::from_utf8(bytes).map_err(|e| {
@@ -82,15 +90,21 @@ pub fn load(bytes: &[u8], name: &str) -> Result<Model> {
             } else {
                 &meta.name
             };
-            Model::try_new(name, "json", &meta.units, mesh)
+            let declared = json::unit_scale(&meta.units);
+            Model::try_new_placed(name, "json", &meta.units, mesh, setup, declared)
         }
         Format::Obj => {
             let text = String::from_utf8_lossy(bytes);
-            Model::try_new(name, "obj", "mm (assumed)", obj::read(&text)?)
+            let units = match setup.model_units {
+                Some(u) => u.name().to_string(),
+                None => "mm (assumed)".to_string(),
+            };
+            Model::try_new_placed(name, "obj", &units, obj::read(&text)?, setup, None)
         }
         Format::Tsm => {
             let (mesh, meta) = tsm::read(bytes)?;
-            Model::try_new(name, "tsm", &meta.units_label(), mesh)
+            let declared = Some(meta.metres_per_unit * 1000.0);
+            Model::try_new_placed(name, "tsm", &meta.units_label(), mesh, setup, declared)
         }
     }
 }

@@ -4,6 +4,7 @@
 //! (that is `io`) or evaluate (that is `surface`).
 
 pub mod samples;
+pub mod setup;
 
 use crate::error::Result;
 use crate::geom::Aabb;
@@ -20,6 +21,9 @@ pub struct Model {
     pub format: String,
     /// Unit the file declared; coordinates are millimetres whatever it was.
     pub units_read: String,
+    /// How the model was placed ([`setup::ImportSetup::describe`]): "as modelled" unless
+    /// set up.
+    pub placement: String,
     pub mesh: TMesh,
     pub surface: Surface,
     pub layout: PatchLayout,
@@ -53,6 +57,9 @@ pub struct ModelSummary {
     pub name: String,
     pub format: String,
     pub units_read: String,
+    /// How the model was placed: "as modelled", or the unit, scale, up axis, turn and
+    /// table placement applied.
+    pub placement: String,
     pub vertices: usize,
     pub faces: usize,
     pub control_points: usize,
@@ -76,11 +83,42 @@ impl Model {
             name: name.to_string(),
             format: format.to_string(),
             units_read: units_read.to_string(),
+            placement: "as modelled".into(),
             mesh,
             surface,
             concave: std::sync::OnceLock::new(),
             side: std::sync::OnceLock::new(),
         })
+    }
+
+    /// As [`Model::try_new`], the mesh placed by `setup` first, its file having said its
+    /// unit (`declared_mm`, mm per unit) or not: scaled and turned, then (if asked) moved so
+    /// the surface's lowest point is at Z 0 (the surface is built again for that).
+    pub fn try_new_placed(
+        name: &str,
+        format: &str,
+        units_read: &str,
+        mesh: TMesh,
+        setup: &setup::ImportSetup,
+        declared_mm: Option<f64>,
+    ) -> Result<Self> {
+        let factor = setup.factor(declared_mm)?;
+        let turned = factor != 1.0 || setup.up != setup::Up::Z || setup.rotate_deg != 0;
+        let mesh = if turned {
+            setup.apply(&mesh, factor)?
+        } else {
+            mesh
+        };
+        let mut m = Model::try_new(name, format, units_read, mesh)?;
+        if setup.on_table {
+            let z = m.surface.bbox().min[2];
+            if z != 0.0 {
+                let mesh = setup::shifted(&m.mesh, crate::geom::Vector3::new(0.0, 0.0, -z))?;
+                m = Model::try_new(name, format, units_read, mesh)?;
+            }
+        }
+        m.placement = setup.describe(declared_mm.is_some());
+        Ok(m)
     }
 
     /// The same surface cut into the patches of `layout` (a strategy's own rectangles).
@@ -89,6 +127,7 @@ impl Model {
             name: self.name.clone(),
             format: self.format.clone(),
             units_read: self.units_read.clone(),
+            placement: self.placement.clone(),
             mesh: self.mesh.clone(),
             surface: self.surface.clone(),
             layout,
@@ -211,6 +250,7 @@ impl Model {
             name: self.name.clone(),
             format: self.format.clone(),
             units_read: self.units_read.clone(),
+            placement: self.placement.clone(),
             vertices: nv,
             faces: self.mesh.faces().len(),
             control_points: nv,

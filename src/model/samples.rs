@@ -128,6 +128,11 @@ pub fn load_sample(name: &str) -> Result<Model> {
     io::load(sample_json(name)?.as_bytes(), name)
 }
 
+/// As [`load_sample`], placed by `setup`.
+pub fn load_sample_with(name: &str, setup: &super::setup::ImportSetup) -> Result<Model> {
+    io::load_with(sample_json(name)?.as_bytes(), name, setup)
+}
+
 /// Quadratic rational arc from angle `-a` to `a` on the unit circle: control points and
 /// weights.
 fn arc(a: f64) -> [([f64; 2], f64); 3] {

@@ -379,6 +379,21 @@ impl TMesh {
         &self.points
     }
 
+    /// The same mesh with every control point mapped by `f` (a placement: scale, rotation,
+    /// shift); errors where a mapped point is out of range, naming the vertex.
+    pub fn map_points(&self, f: impl Fn(&ControlPoint) -> ControlPoint) -> Result<TMesh> {
+        let mut out = self.clone();
+        for (v, p) in out.points.iter_mut().enumerate() {
+            *p = f(p);
+            if let Some(problem) = control_point_problem(p) {
+                return Err(Error::InvalidMesh(format!(
+                    "vertex {v} after placing the model: {problem}"
+                )));
+            }
+        }
+        Ok(out)
+    }
+
     /// All faces, indexed by face id.
     pub fn faces(&self) -> &[Face] {
         &self.faces

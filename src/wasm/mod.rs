@@ -119,6 +119,29 @@ impl WasmModel {
             .map_err(js_err)
     }
 
+    /// As `fromBytes`, the model placed by `setup`: a plain object with any of
+    /// `model_units` (`"mm"`, `"cm"`, `"m"`, `"inch"`: the unit of a file that does not say),
+    /// `scale`, `up` (`"z"`, `"y"`), `rotate_deg` (0, 90, 180, 270) and `on_table`, as the
+    /// CLI's `--model-units`, `--scale`, `--up`, `--rotate` and `--on-table`.
+    #[wasm_bindgen(js_name = fromBytesPlaced)]
+    pub fn from_bytes_placed(
+        bytes: &[u8],
+        name: &str,
+        setup: JsValue,
+    ) -> Result<WasmModel, JsError> {
+        crate::io::load_with(bytes, name, &import_setup(setup)?)
+            .map(|model| WasmModel { model })
+            .map_err(js_err)
+    }
+
+    /// As `sample`, placed by `setup` (see `fromBytesPlaced`).
+    #[wasm_bindgen(js_name = samplePlaced)]
+    pub fn sample_placed(name: &str, setup: JsValue) -> Result<WasmModel, JsError> {
+        samples::load_sample_with(name, &import_setup(setup)?)
+            .map(|model| WasmModel { model })
+            .map_err(js_err)
+    }
+
     /// The model's name.
     #[wasm_bindgen(getter)]
     pub fn name(&self) -> String {
@@ -287,6 +310,16 @@ impl WasmModel {
             rest_positions,
             rest_why,
         }
+    }
+}
+
+/// A model set-up from a plain JavaScript object (the identity for `undefined` or `null`).
+fn import_setup(setup: JsValue) -> Result<crate::model::setup::ImportSetup, JsError> {
+    if setup.is_undefined() || setup.is_null() {
+        Ok(Default::default())
+    } else {
+        serde_wasm_bindgen::from_value(setup)
+            .map_err(|e| JsError::new(&format!("invalid model placement: {e}")))
     }
 }
 

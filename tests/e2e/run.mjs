@@ -1283,6 +1283,55 @@ test('compare: bumps-hole, every strategy side by side as tspath compare has it;
   return `6 rows; ${exact} of ${numbers} numbers bit-equal to the CLI (largest relative difference ${worst.toExponential(1)}); compared in ${(ticks[ticks.length - 1] / 1000).toFixed(1)} s, ${ticks.length} progress updates, longest gap ${Math.round(Math.max(...gaps))} ms; picked row drawn (${px} px)`;
 });
 
+test('placement: a Y-up OBJ cage in centimetres read as tspath reads it with --model-units cm --up y --on-table: the same box in mm and the same program', async (page, url) => {
+  // A wavy sheet as a modelling tool writes it: Y up, in centimetres.
+  const lines = [];
+  const [nx, nz] = [9, 5];
+  for (let k = 0; k < nz; k++) {
+    for (let i = 0; i < nx; i++) {
+      const x = 0.5 * i;
+      lines.push(`v ${x} ${(0.3 * Math.sin(1.3 * x)).toFixed(6)} ${(-0.6 * k).toFixed(6)}`);
+    }
+  }
+  for (let k = 0; k + 1 < nz; k++) {
+    for (let i = 0; i + 1 < nx; i++) {
+      const id = (a, b) => b * nx + a + 1;
+      lines.push(`f ${id(i, k)} ${id(i + 1, k)} ${id(i + 1, k + 1)} ${id(i, k + 1)}`);
+    }
+  }
+  const obj = `${lines.join('\n')}\n`;
+  await writeFile(join(work, 'sheet-cm.obj'), obj);
+  await page.goto(`${url}?model=dome&model-units=cm&up=y&on-table=1&tool-radius=1&scallop=0.05`);
+  await waitState(page, 'model-loaded');
+  await page.uncheck('#auto');
+  await page.setInputFiles('#file', { name: 'sheet-cm.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'sheet-cm' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
+  const flags = ['--model-units', 'cm', '--up', 'y', '--on-table'];
+  const info = JSON.parse(runCli(['info', 'sheet-cm.obj', ...flags]).stdout);
+  const mine = await host(page, (el) => el.model.summary);
+  const size = Math.hypot(...info.bbox_mm.max.map((v, k) => v - info.bbox_mm.min[k]));
+  const d = Math.max(...[0, 1, 2].flatMap((k) => [Math.abs(mine.bbox_mm.min[k] - info.bbox_mm.min[k]), Math.abs(mine.bbox_mm.max[k] - info.bbox_mm.max[k])]));
+  check(d <= 1e-9 * size, `the page's box ${JSON.stringify(mine.bbox_mm)} is the CLI's ${JSON.stringify(info.bbox_mm)}`);
+  check(Math.abs(info.bbox_mm.min[2]) < 1e-9 && info.bbox_mm.max[0] - info.bbox_mm.min[0] > 39.9, `in mm, on the table: ${JSON.stringify(info.bbox_mm)}`);
+  const shown = (await page.textContent('#summary-placement')).trim();
+  check(shown === info.placement && /Y up/.test(shown) && /table/.test(shown), `placement shown: “${shown}”`);
+  const q = new URL(page.url()).searchParams;
+  check(q.get('model-units') === 'cm' && q.get('up') === 'y' && q.get('on-table') === '1', `the URL keeps the placement: ${page.url()}`);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  const cli = cliPlan('sheet-cm.obj', { toolRadius: 1, scallop: 0.05, extra: flags });
+  check(g === cli.gcode, `the program is the CLI's (${g.length} vs ${cli.gcode.length} bytes)`);
+  // A change of the placement reads the model again.
+  await setParam(page, 'rotate', '90');
+  await page.waitForFunction((h) => /90°/.test(document.querySelector(h).model?.summary?.placement || ''), HOST);
+  const turned = await host(page, (el) => el.model.summary.bbox_mm);
+  check(Math.abs((turned.max[1] - turned.min[1]) - (info.bbox_mm.max[0] - info.bbox_mm.min[0])) < 1e-9 * size, `a quarter turn swaps x and y: ${JSON.stringify(turned)}`);
+  await page.screenshot({ path: join(shots, 'placement-obj-cm-y-up.png') });
+  return `box ${info.bbox_mm.max.map((v, k) => (v - info.bbox_mm.min[k]).toFixed(2)).join(' × ')} mm as the CLI's; G-code = CLI (${g.length} bytes)`;
+});
+
 test('without WebGL the 2D view draws the regions and rectangles', async (page, url) => {
   await page.goto(`${url}?model=bumps&strategy=watershed&tool-radius=1&scallop=0.05&${SIM}&plan=1`);
   await waitPlans(page, 1);
