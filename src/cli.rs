@@ -21,7 +21,7 @@ const USAGE: &str = "usage:
               [--axis-preset vertical|gan2014|yuan2012]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
-              [-o OUT.nc] [--report REPORT.json]
+              [--work-offset G54..G59] [-o OUT.nc] [--report REPORT.json]
               [--verify [--verify-samples N] [--verify-max-samples N]]
               --verify simulates the cut, from N samples (default 1 000 000; at least a
               spacing of a quarter of sqrt(8 r h)) up to at most --verify-max-samples
@@ -302,6 +302,7 @@ const PLAN_SWITCHES: &[&str] = &[
 ];
 
 const PLAN_FLAGS: &[&str] = &[
+    "--work-offset",
     "--model-units",
     "--scale",
     "--up",
@@ -352,6 +353,17 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     }
     if let Some(v) = a.number("--feed")? {
         opts.feed_mm_min = v;
+    }
+    if let Some(w) = a.value("--work-offset") {
+        let n = w.trim_start_matches(['G', 'g']);
+        opts.work_offset = match n.parse::<u8>() {
+            Ok(g) if (54..=59).contains(&g) => g,
+            _ => {
+                return Err(Error::Io(format!(
+                    "--work-offset: `{w}` is not a work offset; use G54 to G59"
+                )))
+            }
+        };
     }
     let patch = |flag: &'static str| -> Result<Option<u32>> {
         match a.number(flag)? {

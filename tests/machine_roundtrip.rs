@@ -292,3 +292,62 @@ fn joint_space_moves_stay_within_the_chordal_tolerance_of_the_planned_chords() {
         }
     }
 }
+
+/// Every dialect writes the chosen work offset before the first move (issue 18: programs
+/// carried none), in its own words, and still reads back; a bad offset is refused.
+#[test]
+fn every_dialect_writes_the_work_offset() {
+    let planned = sample_plan("dome");
+    let tilted = along_normals(&planned);
+    for offset in [54u8, 55, 58, 59] {
+        let mut o = opts_for("dome");
+        o.work_offset = offset;
+        for m in ["3-axis", "table-table-ac"] {
+            let mach = machine::builtin(m).unwrap();
+            for &(dialect, dname, _) in DIALECTS {
+                let five = !mach.rotaries.is_empty() && dialect != Dialect::Plain;
+                let path = if five { &tilted } else { &planned };
+                let text = post(path, &o, &job("dome"), &mach, dialect, Units::Mm).unwrap();
+                let want = match (dialect, offset) {
+                    (Dialect::Heidenhain, g) => format!("PRESET SELECT #{}", g - 53),
+                    (Dialect::Siemens, 58) => "G505".to_string(),
+                    (Dialect::Siemens, 59) => "G506".to_string(),
+                    (_, g) => format!("G{g}"),
+                };
+                // The offset's block comes before the first block that moves.
+                let at = text
+                    .lines()
+                    .position(|l| {
+                        l.split_whitespace().any(|w| w == want.as_str()) || l.ends_with(&want)
+                    })
+                    .unwrap_or_else(|| panic!("{m} {dname} G{offset}: no `{want}` in\n{text}"));
+                let first_move = text
+                    .lines()
+                    .position(|l| {
+                        l.split_whitespace()
+                            .any(|w| w == "G0" || w == "G1" || w.starts_with("L"))
+                    })
+                    .unwrap();
+                assert!(
+                    at < first_move,
+                    "{m} {dname}: `{want}` at line {at}, first move {first_move}"
+                );
+                let back = reader::read(&text).unwrap();
+                assert!(!back.moves.is_empty());
+            }
+        }
+    }
+    let mut o = opts_for("dome");
+    o.work_offset = 60;
+    let e = post(
+        &planned,
+        &o,
+        &job("dome"),
+        &machine::builtin("3-axis").unwrap(),
+        Dialect::LinuxCnc,
+        Units::Mm,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("work_offset") && e.contains("G54"), "{e}");
+}

@@ -8,7 +8,7 @@
  * attribute); `default`: value when absent (null = the engine's own default, said by `auto`).
  * `fiveAxis`: only for machines that tilt the tool; `isfcOnly`: only for the space-filling
  * curve; `isoplanarOnly`: only for iso-planar slicing; `invert`: a flag whose PlanOptions
- * field is its negation.
+ * field is its negation; `numeric`: a choice whose PlanOptions field is a number.
  */
 export const PARAMS = [
   // Placement of the model (not plan options: the model is read again with them). As the
@@ -51,6 +51,7 @@ export const PARAMS = [
   // Output (not plan options: they choose the program written from the plan)
   { key: 'machine', field: null, group: 'output', label: 'Machine', kind: 'choice', choices: [], default: '3-axis' },
   { key: 'dialect', field: null, group: 'output', label: 'G-code dialect', kind: 'choice', choices: [], default: 'linuxcnc' },
+  { key: 'work-offset', field: 'work_offset', group: 'output', label: 'Work offset (program zero)', kind: 'choice', numeric: true, choices: [['54', 'G54'], ['55', 'G55'], ['56', 'G56'], ['57', 'G57'], ['58', 'G58'], ['59', 'G59']], default: '54' },
   { key: 'units', field: null, group: 'output', label: 'Program units', kind: 'choice', choices: [['mm', 'millimetres (G21)'], ['inch', 'inches (G20)']], default: 'mm' },
   // Simulation
   // As `tspath plan --verify --verify-samples N --verify-max-samples M`: the simulation
@@ -156,7 +157,7 @@ export function planOptions(values, { fiveAxis, paperLeadDeg = 10 }) {
     if (v === null || v === '' || v === undefined) continue;
     if (p.isfcOnly && values.strategy !== 'isfc') continue;
     if (p.isoplanarOnly && values.strategy !== 'isoplanar') continue;
-    o[p.field] = p.invert ? !v : v;
+    o[p.field] = p.invert ? !v : p.numeric ? Number(v) : v;
   }
   if (fiveAxis && values['axis-preset'] === 'gan2014') {
     o.lead_deg = paperLeadDeg;

@@ -168,7 +168,7 @@ const TEMPLATE = `
   </aside>
   <div class="stage">
     <div class="toolbar">
-      <button id="plan" type="button" class="primary">Plan tool path</button>
+      <button id="plan" type="button" class="primary" title="Plan (Ctrl+Enter); Escape cancels" aria-keyshortcuts="Control+Enter">Plan tool path</button>
       <button id="compare" type="button" title="Plan every strategy on this model with these settings, simulate each cut and put them side by side">Compare strategies</button>
       <button id="cancel" type="button" disabled>Cancel</button>
       <label class="inline" title="Re-plan after each change when planning takes under ${AUTO_REPLAN_MS / 1000} s">
@@ -555,6 +555,20 @@ export class TspathPlanner extends HTMLElement {
     $('plan').addEventListener('click', () => this.#plan());
     $('cancel').addEventListener('click', () => this.#cancel());
     $('compare').addEventListener('click', () => this.#compare());
+    // Keys: Escape cancels what is running (wherever the focus is), Ctrl+Enter (⌘+Enter)
+    // plans from anywhere in the element.
+    document.addEventListener('keydown', (e) => {
+      if (e.key === 'Escape' && (this.planning || this.dataset.verify === 'running')) {
+        e.preventDefault();
+        this.#cancel();
+      }
+    });
+    this.addEventListener('keydown', (e) => {
+      if (e.key === 'Enter' && (e.ctrlKey || e.metaKey) && !this.$('plan').disabled) {
+        e.preventDefault();
+        this.#plan();
+      }
+    });
     $('compare-close').addEventListener('click', () => {
       $('compare-panel').hidden = true;
       this.comparison = null;

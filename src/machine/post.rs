@@ -402,6 +402,15 @@ pub fn post_program(
             return Err(Error::param(name, format!("must be positive, got {v}")));
         }
     }
+    if !(54..=59).contains(&opts.work_offset) {
+        return Err(Error::param(
+            "work_offset",
+            format!(
+                "must be one of 54 to 59 (G54–G59), got {}",
+                opts.work_offset
+            ),
+        ));
+    }
     let r = path.tool_radius_mm;
     let five = machine.kinematics() != Kinematics::ThreeAxis;
     let mode = match (five, dialect) {
@@ -537,8 +546,10 @@ pub fn post_program(
     let names: String = rot_order.iter().map(|(n, _)| format!(" {n}")).collect();
     o.comment(&match mode {
         OutputMode::ThreeAxis => "positions: tool tip X Y Z".to_string(),
-        OutputMode::Joints => format!("positions: machine joints X Y Z{names} (degrees)"),
-        OutputMode::ToolTip => format!("positions: tool tip X Y Z, rotaries{names} (degrees)"),
+        OutputMode::Joints => {
+            format!("positions: machine joints X Y Z{names}, rotaries in degrees")
+        }
+        OutputMode::ToolTip => format!("positions: tool tip X Y Z, rotaries{names} in degrees"),
     });
     o.comment(&format!(
         "units: {}, feed {}/min{}",
@@ -567,10 +578,16 @@ pub fn post_program(
         extra: "",
         source: Source::Safe,
     };
+    // The work offset: the program's zero is where the operator set it.
+    let offset = opts.work_offset;
+    o.comment(&format!(
+        "program zero: work offset G{offset}, set at the model's origin"
+    ));
     match syntax {
         Syntax::Iso => {
             let g = if units == Units::Mm { "G21" } else { "G20" };
             o.line(&format!("{g} G90 G17 G94 G40 G49 G80"));
+            o.line(&format!("G{offset}"));
             o.motion(&safe_top());
             o.line("T1 M6");
             if !(dialect == Dialect::Fanuc && mode == OutputMode::ToolTip) {
@@ -581,12 +598,22 @@ pub fn post_program(
         Syntax::Siemens => {
             let g = if units == Units::Mm { "G710" } else { "G700" };
             o.line(&format!("{g} G90 G17 G94 G40"));
+            // G58 and G59 are programmable frames on Siemens: the fifth and sixth settable
+            // offsets are G505 and G506.
+            let frame = match offset {
+                58 => 505,
+                59 => 506,
+                g => g as u32,
+            };
+            o.line(&format!("G{frame}"));
             o.motion(&safe_top());
             o.line("T1 M6");
             o.line("D1");
             o.line(&format!("S{} M3", feed_text(opts.spindle_rpm)));
         }
         Syntax::Heidenhain => {
+            // The preset table's line 1–6 stands for G54–G59.
+            o.line(&format!("PRESET SELECT #{}", offset - 53));
             o.motion(&safe_top());
             o.line(&format!("TOOL CALL 1 Z S{}", feed_text(opts.spindle_rpm)));
         }

@@ -6,7 +6,7 @@
 //! [`super::roundtrip`] with [`super::kinematics`]).
 //!
 //! Supported: G0 G1, G17–G19, G20 G21 (and Siemens G700 G710), G40, G43 G43.4 G49, G53, G54–G59
-//! (taken as zero offsets), G80, G90 G91, G93 G94, G4; M codes (M128/M129 switch the
+//! and Siemens G505–G599, Heidenhain PRESET SELECT (taken as zero offsets), G80, G90 G91, G93 G94, G4; M codes (M128/M129 switch the
 //! tool-centre point); Siemens TRAORI TRAFOOF SUPA ORI…; Heidenhain `L` blocks, FMAX, M91,
 //! FUNCTION TCPM. Anything else that moves the tool (arcs, cycles, G28, subprograms) is an
 //! error naming the line, never silently skipped.
@@ -213,7 +213,7 @@ fn read_iso(text: &str) -> Result<Program> {
                         return Err(err(n, "arcs (G2/G3) are not read; only straight moves"))
                     }
                     40 | 170 | 180 | 190 | 400 | 430 | 800 => {}
-                    540..=590 => {}
+                    540..=590 | 5050..=5990 => {}
                     200 | 7000 => s.units = Units::Inch,
                     210 | 7100 => s.units = Units::Mm,
                     700 | 710 => {
@@ -390,6 +390,8 @@ fn read_heidenhain(text: &str) -> Result<Program> {
                 ended = head == "END";
             }
             "TOOL" | "BLK" | "STOP" => {}
+            // The preset (work offset) is taken as zero, as G54–G59 are.
+            "PRESET" if parts.next() == Some("SELECT") => {}
             "FUNCTION" => match parts.next() {
                 Some("TCPM") => s.tcp = true,
                 Some("RESET") if parts.next() == Some("TCPM") => s.tcp = false,

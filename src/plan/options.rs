@@ -30,6 +30,10 @@ pub struct PlanOptions {
     pub plunge_feed_mm_min: f64,
     /// Spindle speed (rev/min). Default 12000 rpm.
     pub spindle_rpm: f64,
+    /// Work offset the program runs in: 54 to 59 for G54–G59 (Heidenhain: preset 1–6,
+    /// Siemens G54–G57 and G505/G506 for the last two). Default 54: the program's zero is
+    /// where the operator set G54.
+    pub work_offset: u8,
     /// Patch the path starts on. Default patch 0.
     pub start_patch: Option<u32>,
     /// Patch the path should finish on. Default: wherever the shortest order ends.
@@ -155,6 +159,7 @@ impl Default for PlanOptions {
             feed_mm_min: 1000.0,
             plunge_feed_mm_min: 300.0,
             spindle_rpm: 12000.0,
+            work_offset: 54,
             start_patch: None,
             finish_patch: None,
             crossfeed: None,
@@ -279,6 +284,15 @@ impl PlanOptions {
         positive("feed_mm_min", self.feed_mm_min, "mm/min")?;
         positive("plunge_feed_mm_min", self.plunge_feed_mm_min, "mm/min")?;
         positive("spindle_rpm", self.spindle_rpm, "rev/min")?;
+        if !(54..=59).contains(&self.work_offset) {
+            return Err(Error::param(
+                "work_offset",
+                format!(
+                    "must be one of 54 to 59 (G54–G59), got {}",
+                    self.work_offset
+                ),
+            ));
+        }
         positive("shank_length_mm", self.shank_length_mm, "mm")?;
         positive("holder_radius_mm", self.holder_radius_mm, "mm")?;
         positive("holder_length_mm", self.holder_length_mm, "mm")?;

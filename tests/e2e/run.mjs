@@ -613,6 +613,27 @@ test('Cancel stops a long plan within 0.5 s; the page answers clicks while plann
   return `cancel ${cancel.ms.toFixed(1)} ms (at ${(100 * progress).toFixed(1)} % done); click during planning answered in ${clickMs} ms, event-loop lag ${lag.toFixed(1)} ms; next plan (three-axis) done ${after} ms later: planned with problems, rest ${cli.report.unreachable_area_mm2.toFixed(1)} mm² (${why}), ${rest} px`;
 });
 
+test('keys: Escape cancels a long plan, Ctrl+Enter plans', async (page, url) => {
+  await page.goto(`${url}?model=head&machine=table-table-ac`);
+  await waitState(page, 'model-loaded');
+  await page.uncheck('#auto');
+  await page.click('#plan');
+  await waitState(page, 'planning');
+  const t0 = Date.now();
+  await page.keyboard.press('Escape');
+  await waitState(page, 'model-loaded', 5000);
+  const ms = Date.now() - t0;
+  check(/cancelled/i.test(await page.textContent('#status')), `Escape cancelled: ${await page.textContent('#status')}`);
+  await setParam(page, 'machine', '3-axis');
+  await setParam(page, 'scallop', 0.2);
+  await page.focus('#view');
+  await page.keyboard.press('Control+Enter');
+  await waitPlans(page, 1);
+  const r = await host(page, (el) => el.plan.planReport);
+  check(r.cl_points > 0, `Ctrl+Enter planned: ${r.cl_points} CL points`);
+  return `Escape back to the model in ${ms} ms; Ctrl+Enter planned ${r.cl_points} CL points`;
+});
+
 test('the closed head, five-axis from the URL: cut all round, no gouge, same as the CLI', async (page, url) => {
   const h = 0.05;
   // A million samples (no growth: the cap is the start) give a finite error bound on the
@@ -1323,6 +1344,15 @@ test('placement: a Y-up OBJ cage in centimetres read as tspath reads it with --m
   const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
   const cli = cliPlan('sheet-cm.obj', { toolRadius: 1, scallop: 0.05, extra: flags });
   check(g === cli.gcode, `the program is the CLI's (${g.length} vs ${cli.gcode.length} bytes)`);
+  check(/\nG54\n/.test(g), 'the program runs in G54 by default');
+  // Another work offset: the program says it, as the CLI's --work-offset does.
+  await setParam(page, 'work-offset', '55');
+  await page.click('#plan');
+  await waitPlans(page, 2);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g55 = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  const cli55 = cliPlan('sheet-cm.obj', { toolRadius: 1, scallop: 0.05, extra: [...flags, '--work-offset', 'G55'] });
+  check(g55 === cli55.gcode && /\nG55\n/.test(g55) && !/\nG54\n/.test(g55), `G55: the CLI's program (${g55.length} vs ${cli55.gcode.length} bytes)`);
   // A change of the placement reads the model again.
   await setParam(page, 'rotate', '90');
   await page.waitForFunction((h) => /90°/.test(document.querySelector(h).model?.summary?.placement || ''), HOST);
@@ -1331,6 +1361,26 @@ test('placement: a Y-up OBJ cage in centimetres read as tspath reads it with --m
   await page.screenshot({ path: join(shots, 'placement-obj-cm-y-up.png') });
   return `box ${info.bbox_mm.max.map((v, k) => (v - info.bbox_mm.min[k]).toFixed(2)).join(' × ')} mm as the CLI's; G-code = CLI (${g.length} bytes)`;
 });
+
+for (const [w, h] of [[390, 844], [768, 1024]]) {
+  test(`layout at ${w} × ${h}: the view and Plan on screen, no sideways scrolling`, async (page, url) => {
+    await page.goto(`${url}?model=dome`);
+    await waitState(page, 'model-loaded');
+    const m = await page.evaluate(() => ({ sw: document.documentElement.scrollWidth, iw: innerWidth, ih: innerHeight }));
+    check(m.sw <= m.iw, `no sideways scrolling: the page is ${m.sw} px wide in a ${m.iw} px window`);
+    const plan = await page.locator('#plan').boundingBox();
+    const view = await page.locator('#view').boundingBox();
+    const inside = (b) => b && b.x >= 0 && b.x + b.width <= m.iw + 0.5 && b.y >= 0;
+    check(inside(plan) && plan.y + plan.height <= m.ih, `Plan on screen: ${JSON.stringify(plan)}`);
+    check(inside(view) && view.y < m.ih && view.height >= 250 && view.width >= 300, `the view on screen: ${JSON.stringify(view)}`);
+    const tick = await page.locator('#layer-path').boundingBox();
+    check(tick.width >= 18 && tick.height >= 18, `checkboxes ${tick.width} × ${tick.height} px`);
+    const px = await host(page, (el) => el.countPixels().drawn);
+    check(px > 1000, `the model is drawn (${px} px)`);
+    await page.screenshot({ path: join(shots, `layout-${w}x${h}.png`) });
+    return `page ${m.sw} px in ${m.iw} px; Plan at y ${Math.round(plan.y)}, view ${Math.round(view.width)} × ${Math.round(view.height)} px at y ${Math.round(view.y)}`;
+  }, { viewport: { width: w, height: h } });
+}
 
 test('without WebGL the 2D view draws the regions and rectangles', async (page, url) => {
   await page.goto(`${url}?model=bumps&strategy=watershed&tool-radius=1&scallop=0.05&${SIM}&plan=1`);
