@@ -232,7 +232,7 @@ const TEMPLATE = `
     </section>
     <section class="listing-section">
       <h2 id="listing-title">G-code</h2>
-      <ol id="listing" class="listing" aria-labelledby="listing-title"></ol>
+      <ol id="listing" class="listing" aria-labelledby="listing-title" tabindex="0"></ol>
       <h2>Downloads</h2>
       <div class="downloads">
         <button id="download-gcode" type="button" disabled>G-code</button>

@@ -1393,6 +1393,30 @@ test('without WebGL the 2D view draws the regions and rectangles', async (page, 
   return `${px} px`;
 }, { noWebGL: true });
 
+test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
+  const axePath = join(root, 'tests', 'e2e', 'node_modules', 'axe-core', 'axe.min.js');
+  const audit = async (what) => {
+    await page.addScriptTag({ path: axePath });
+    const r = await page.evaluate(async () => {
+      // eslint-disable-next-line no-undef
+      const res = await axe.run(document, { resultTypes: ['violations'] });
+      return res.violations.map((v) => ({ id: v.id, impact: v.impact, help: v.help, nodes: v.nodes.slice(0, 3).map((n) => n.target.join(' ')) }));
+    });
+    const bad = r.filter((v) => v.impact === 'serious' || v.impact === 'critical');
+    check(bad.length === 0, `${what}: ${bad.map((v) => `${v.impact} ${v.id} (${v.help}) at ${v.nodes.join('; ')}`).join(' | ')}`);
+    return r;
+  };
+  await page.goto(`${url}?model=dome&scallop=0.05&${SIM}&plan=1`);
+  await waitPlans(page, 1);
+  await waitVerified(page);
+  const main = await audit('main page, planned');
+  await page.goto(`${url}examples/embed.html`);
+  await page.waitForSelector('tspath-planner[data-state="model-loaded"], tspath-planner[data-state="planned"]', { timeout: 60000, state: 'attached' });
+  const embed = await audit('embed');
+  const minor = [...main, ...embed].map((v) => `${v.impact} ${v.id}`);
+  return `no serious or critical violation; lesser ones: ${minor.length ? [...new Set(minor)].join(', ') : 'none'}`;
+});
+
 // ------------------------------------------------------------------ run
 const wasmBytes = readFileSync(join(root, 'www', 'pkg', 'tspath_bg.wasm'));
 const wasmGz = gzipSync(wasmBytes, { level: 9 }).length;
