@@ -91,9 +91,10 @@ export function validate(raw, { patches = 1, fiveAxis = false } = {}) {
         else errors[p.key] = `${p.label} is required (${p.unit})`;
         continue;
       }
-      const v = Number(s);
+      // A decimal comma (“0,02”) is read as the point it stands for.
+      const v = /^[+-]?\d*,\d+$/.test(s) ? Number(s.replace(',', '.')) : s === '' ? NaN : Number(s);
       if (!Number.isFinite(v)) {
-        errors[p.key] = `${p.label}: “${s}” is not a number`;
+        errors[p.key] = `${p.label}: “${s}” is not a number (${p.unit}; write decimals as 0.02 or 0,02)`;
       } else if (v < p.min || v > p.max) {
         errors[p.key] = `${p.label} must be between ${p.min} and ${p.max} ${p.unit}`;
       } else if (p.integer && !Number.isInteger(v)) {

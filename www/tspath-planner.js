@@ -115,6 +115,9 @@ const COMPARE_CHARTS = [
 /** A run's value for a column key (from its simulated cut where the column says so). */
 const runValue = (run, key, fromSim) => (fromSim ? run.simulated?.[key] : run[key]);
 
+/** URL keys that are not parameters: the model, and whether to plan or compare. */
+const URL_KEYS = ['model', 'plan', 'compare'];
+
 /** The layers a plan of some strategies brings along (drawn without planning again), each
  * with its view setter, legend heading, box titles and legend rows (`[colour, text, filled]`). */
 const OVERLAYS = {
@@ -437,11 +440,16 @@ export class TspathPlanner extends HTMLElement {
       console.warn(`The engine's simulation cap is ${info.verifyMaxSamples} samples, the page's default ${byKey['max-samples'].default}`);
     }
 
-    // Initial values: attributes, then the URL if synced.
+    // Initial values: attributes, then the URL if synced; parameters this page does not
+    // know are named in the status once the model is loaded.
     const initial = {};
     for (const a of this.getAttributeNames()) initial[a] = this.getAttribute(a);
+    const unknown = [];
     if (this.hasAttribute('sync-url')) {
-      for (const [k, v] of new URLSearchParams(location.search)) initial[k] = v;
+      for (const [k, v] of new URLSearchParams(location.search)) {
+        initial[k] = v;
+        if (!byKey[k] && !URL_KEYS.includes(k)) unknown.push(k);
+      }
     }
     for (const p of PARAMS) {
       if (initial[p.key] !== undefined && initial[p.key] !== null) this.#setControl(p, initial[p.key]);
@@ -453,6 +461,9 @@ export class TspathPlanner extends HTMLElement {
     this.#validateAll();
     const model = initial.model || info.samples[0];
     const loaded = await this.#loadNamed(model);
+    if (loaded && unknown.length) {
+      this.#status(`The link's ${unknown.map((k) => `“${k}”`).join(', ')} ${unknown.length === 1 ? 'is not a parameter' : 'are not parameters'} of this page (left out); the parameters are ${PARAMS.map((p) => p.key).join(', ')}.`, 'warning');
+    }
     const flag = (x) => x !== undefined && x !== null && x !== '0' && x !== 'false';
     if (loaded && flag(initial.plan)) await this.#plan();
     if (loaded && flag(initial.compare)) this.#compare();
@@ -510,12 +521,13 @@ export class TspathPlanner extends HTMLElement {
           label.textContent = ` ${p.label}`;
           label.prepend(control);
         } else if (p.kind === 'number') {
+          // Text, not type=number: the browser would turn “0,02” or “1e” into an empty
+          // value before the checks could say what was read.
           control = document.createElement('input');
-          control.type = 'number';
-          control.min = p.min;
-          control.max = p.max;
-          control.step = 'any';
+          control.type = 'text';
           control.inputMode = 'decimal';
+          control.autocomplete = 'off';
+          control.spellcheck = false;
           if (p.default === null) {
             control.placeholder = `auto: ${p.auto}`;
           } else {

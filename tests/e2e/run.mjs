@@ -1393,6 +1393,25 @@ test('without WebGL the 2D view draws the regions and rectangles', async (page, 
   return `${px} px`;
 }, { noWebGL: true });
 
+test('inputs: a decimal comma is read as a point, a bad number is echoed, an unknown URL parameter is named', async (page, url) => {
+  await page.goto(`${url}?model=dome&scalop=0.1&tool-radius=1`);
+  await waitState(page, 'model-loaded');
+  const status = await page.textContent('#status');
+  check(/“scalop”/.test(status) && /not a parameter/.test(status), `the unknown parameter is named: ${status}`);
+  await page.uncheck('#auto');
+  await setParam(page, 'scallop', '0,02');
+  const err = (await page.textContent('#p-scallop-error')).trim();
+  check(err === '', `“0,02” is accepted: “${err}”`);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  const h = await host(page, (el) => el.plan.options.scallop_mm);
+  check(h === 0.02, `planned with a 0.02 mm scallop: ${h}`);
+  await setParam(page, 'scallop', '1e');
+  const bad = (await page.textContent('#p-scallop-error')).trim();
+  check(/“1e”/.test(bad) && /not a number/.test(bad), `“1e” is echoed: ${bad}`);
+  return `“0,02” planned as ${h} mm; “1e”: ${bad}; status: ${status.slice(0, 60)}…`;
+});
+
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
   const axePath = join(root, 'tests', 'e2e', 'node_modules', 'axe-core', 'axe.min.js');
   const audit = async (what) => {
