@@ -516,7 +516,7 @@ fn compare_cmd(args: &[String]) -> Result<String> {
         )
     };
     let t0 = Instant::now();
-    let c = plan::compare::compare(
+    let (c, _) = plan::compare::compare(
         &m,
         &opts,
         &entries,

@@ -194,11 +194,12 @@ fn progress_is_monotone_and_covers_the_simulations() {
         .with_scallop(0.05);
     let entries = Entry::parse_list(Some("isoparametric,isfc")).unwrap();
     let mut seen: Vec<f64> = Vec::new();
-    let c = compare::compare(&m, &o, &entries, None, Some(1_000_000), &|| 0.0, &mut |f| {
+    let (c, kept) = compare::compare(&m, &o, &entries, None, Some(1_000_000), &|| 0.0, &mut |f| {
         seen.push(f);
         true
     })
     .unwrap();
+    assert!(kept.iter().all(|k| k.is_some()));
     assert_eq!(c.runs.len(), 2);
     assert!(seen.windows(2).all(|w| w[1] >= w[0]), "{seen:?}");
     assert_eq!(*seen.last().unwrap(), 1.0);

@@ -171,6 +171,30 @@ fn allowed(
         .collect())
 }
 
+/// The tool tip of every move of `path` (the ball centre less the radius along the axis).
+pub fn tips(path: &crate::plan::Toolpath) -> Vec<Point3> {
+    let r = path.tool_radius_mm;
+    path.moves
+        .iter()
+        .map(|m| m.cl_point - m.tool_axis * r)
+        .collect()
+}
+
+/// The pose every move of `path` asks for, its tips being `tips`: a rapid (and the first
+/// move) starts a chain, where the rotaries may re-choose.
+pub fn path_requests(path: &crate::plan::Toolpath, tips: &[Point3]) -> Vec<PoseRequest> {
+    path.moves
+        .iter()
+        .zip(tips)
+        .enumerate()
+        .map(|(i, (m, t))| PoseRequest {
+            tip: *t,
+            axis: m.tool_axis,
+            starts_chain: i == 0 || m.kind == crate::plan::MoveKind::Rapid,
+        })
+        .collect()
+}
+
 /// The joint values of every pose (see the module documentation for how they are chosen), or
 /// an error naming the first move the machine cannot do.
 pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {

@@ -26,7 +26,7 @@
 //! Owns: the dynamics fields of a machine and the time model. Must not: change the path or
 //! choose joint values (that is [`super::joints`]).
 
-use super::joints::{self, PoseRequest};
+use super::joints;
 use super::kinematics::Machine;
 use crate::plan::{MoveKind, PlanOptions, Toolpath};
 use serde::{Deserialize, Serialize};
@@ -319,27 +319,11 @@ impl PathTimes {
 /// The joint values are the post's ([`joints::solve`]); where the machine cannot take the
 /// path, the tool axis' turn stands in for the rotaries'.
 pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> PathTimes {
-    let r = path.tool_radius_mm;
-    let tips: Vec<crate::geom::Point3> = path
-        .moves
-        .iter()
-        .map(|m| m.cl_point - m.tool_axis * r)
-        .collect();
+    let tips = joints::tips(path);
     let joints = if machine.rotaries.is_empty() {
         None
     } else {
-        let requests: Vec<PoseRequest> = path
-            .moves
-            .iter()
-            .zip(&tips)
-            .enumerate()
-            .map(|(i, (m, t))| PoseRequest {
-                tip: *t,
-                axis: m.tool_axis,
-                starts_chain: i == 0 || m.kind == MoveKind::Rapid,
-            })
-            .collect();
-        joints::solve(machine, &requests).ok()
+        joints::solve(machine, &joints::path_requests(path, &tips)).ok()
     };
     let from_joints = machine.rotaries.is_empty() || joints.is_some();
     let segs: Vec<Segment> = (1..path.moves.len())

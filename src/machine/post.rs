@@ -21,7 +21,7 @@
 //! retract along the tool axis to the clearance height (the highest cutting point along that
 //! axis plus `clearance_mm`) unless the path already ends there, then the safe Z again.
 
-use super::joints::{self, PoseRequest};
+use super::joints;
 use super::kinematics::{Joints, Kinematics, Machine};
 use super::JobInfo;
 use crate::error::{Error, Result};
@@ -418,11 +418,7 @@ pub fn post_program(
         (true, Dialect::LinuxCnc) => OutputMode::Joints,
         (true, _) => OutputMode::ToolTip,
     };
-    let tips: Vec<Point3> = path
-        .moves
-        .iter()
-        .map(|m| m.cl_point - m.tool_axis * r)
-        .collect();
+    let tips = joints::tips(path);
     for (i, m) in path.moves.iter().enumerate() {
         let ok = m.cl_point.iter().all(|x| x.is_finite())
             && m.tool_axis.iter().all(|x| x.is_finite())
@@ -465,18 +461,7 @@ pub fn post_program(
         }
         out
     } else {
-        let requests: Vec<PoseRequest> = path
-            .moves
-            .iter()
-            .zip(&tips)
-            .enumerate()
-            .map(|(i, (m, t))| PoseRequest {
-                tip: *t,
-                axis: m.tool_axis,
-                starts_chain: i == 0 || m.kind == MoveKind::Rapid,
-            })
-            .collect();
-        joints::solve(machine, &requests)?
+        joints::solve(machine, &joints::path_requests(path, &tips))?
     };
 
     // Rotary words in address order (A, B, C).

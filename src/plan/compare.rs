@@ -220,39 +220,18 @@ pub fn l_min_mm(model: &Model, r: f64, h: f64) -> f64 {
         .sum()
 }
 
-/// Plans `model` with each of `entries` and `opts` otherwise, times each on `machine` (each
-/// plan's default machine when `None`) and, with `verify_max_samples`, simulates each cut
-/// until its error bound is a quarter of the scallop (or that many samples). `clock` gives
-/// milliseconds (the caller owns the clock); `progress` gets the fraction done and returns
-/// `false` to cancel (an [`Error::Cancelled`]).
-pub fn compare(
-    model: &Model,
-    opts: &PlanOptions,
-    entries: &[Entry],
-    machine: Option<&Machine>,
-    verify_max_samples: Option<usize>,
-    clock: &dyn Fn() -> f64,
-    progress: &mut dyn FnMut(f64) -> bool,
-) -> Result<Comparison> {
-    compare_keeping(
-        model,
-        opts,
-        entries,
-        machine,
-        verify_max_samples,
-        clock,
-        progress,
-    )
-    .map(|(c, _)| c)
-}
-
 /// A strategy's plan as the comparison made it: the plan, its options and its report
 /// (without the simulation's findings).
 pub type Kept = (Planned, PlanOptions, PlanReport);
 
-/// As [`compare`], also returning each row's plan (`None` where it could not plan), so a
-/// caller can make one the current plan without planning again.
-pub fn compare_keeping(
+/// Plans `model` with each of `entries` and `opts` otherwise, times each on `machine` (each
+/// plan's default machine when `None`) and, with `verify_max_samples`, simulates each cut
+/// until its error bound is a quarter of the scallop (or that many samples). Returns the
+/// table and each row's plan (`None` where it could not plan), so that a caller can make
+/// one the current plan without planning again. `clock` gives
+/// milliseconds (the caller owns the clock); `progress` gets the fraction done and returns
+/// `false` to cancel (an [`Error::Cancelled`]).
+pub fn compare(
     model: &Model,
     opts: &PlanOptions,
     entries: &[Entry],

@@ -267,7 +267,7 @@ impl WasmModel {
             .transpose()
             .map_err(js_err)?;
         let mut cb = progress_callback(&progress);
-        let (comparison, kept) = crate::plan::compare::compare_keeping(
+        let (comparison, kept) = crate::plan::compare::compare(
             &self.model,
             &opts,
             &entries,
