@@ -14,6 +14,7 @@
 // `data-verify` whether the cutting simulation is running, done or failed; `data-stale`
 // that the parameters no longer match the plan shown (its downloads are off).
 import { CancelledError, EngineClient } from './client.js';
+import { loadLastFile, saveLastFile } from './storage.js';
 import {
   BACKGROUND_LIGHT, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
 } from './colours.js';
@@ -114,6 +115,9 @@ const COMPARE_CHARTS = [
 
 /** A run's value for a column key (from its simulated cut where the column says so). */
 const runValue = (run, key, fromSim) => (fromSim ? run.simulated?.[key] : run[key]);
+
+/** How the URL names a file of the user's kept in the browser (`model=file:NAME`). */
+const FILE_PREFIX = 'file:';
 
 /** URL keys that are not parameters: the model, and whether to plan or compare. */
 const URL_KEYS = ['model', 'plan', 'compare'];
@@ -460,7 +464,7 @@ export class TspathPlanner extends HTMLElement {
     this.ready = true;
     this.#validateAll();
     const model = initial.model || info.samples[0];
-    const loaded = await this.#loadNamed(model);
+    const loaded = model.startsWith(FILE_PREFIX) ? await this.#loadStored(model.slice(FILE_PREFIX.length)) : await this.#loadNamed(model);
     if (loaded && unknown.length) {
       this.#status(`The link's ${unknown.map((k) => `“${k}”`).join(', ')} ${unknown.length === 1 ? 'is not a parameter' : 'are not parameters'} of this page (left out); the parameters are ${PARAMS.map((p) => p.key).join(', ')}.`, 'warning');
     }
@@ -651,6 +655,18 @@ export class TspathPlanner extends HTMLElement {
 
   // ---------------------------------------------------------------- models
 
+  /** Opens the file kept from the last visit (a reload, or a link naming `file:NAME`);
+   * says so, and opens the first sample, when this browser does not have it. */
+  async #loadStored(name) {
+    const kept = await loadLastFile();
+    if (kept && kept.name === name) {
+      return this.#load({ bytes: kept.bytes, name: name.replace(/\.[^.]*$/, '') }, name);
+    }
+    const ok = await this.#loadNamed(this.info.samples[0]);
+    this.#status(`The file “${name}” is not kept in this browser (files stay on the machine they were opened on): open it again.`, 'warning');
+    return ok;
+  }
+
   /** Reads the model shown again (after a change of its placement). */
   async #reload() {
     const m = this.model;
@@ -734,6 +750,10 @@ export class TspathPlanner extends HTMLElement {
     // `sample`: the picker's (and the URL's) name for it, null for a file of the user's.
     const sample = source.sample ?? pub?.id ?? null;
     this.model = { ...m, sample, file: source.sample ? null : label, pub };
+    // A file of the user's is kept for the next visit (the URL names it).
+    if (!source.sample && !pub && source.bytes) {
+      saveLastFile(label, source.bytes).catch((e) => console.warn('could not keep the file:', e));
+    }
     this.#clearPlan();
     // A comparison is of the model it was made on.
     this.comparison = null;
@@ -1816,7 +1836,19 @@ export class TspathPlanner extends HTMLElement {
   // ---------------------------------------------------------------- view
 
   #showColours() {
-    const heat = this.$('colour-heat').checked && this.plan && this.plan.verification;
+    const heat = !!(this.$('colour-heat').checked && this.plan && this.plan.verification);
+    // The path would hide the heat map: off while the map shows, back as it was after.
+    if (heat !== !!this.heatShown) {
+      const box = this.$('layer-path');
+      if (heat) {
+        this.pathBeforeHeat = box.checked;
+        box.checked = false;
+      } else if (this.pathBeforeHeat !== undefined) {
+        box.checked = this.pathBeforeHeat;
+      }
+      this.view.setLayers({ path: box.checked });
+      this.heatShown = heat;
+    }
     if (heat) {
       this.view.setHeat(this.plan.verification.heat, this.plan.verification.summary.requested_scallop_mm);
       this.#heatLegend(this.plan.verification.summary.requested_scallop_mm);
@@ -1987,6 +2019,7 @@ export class TspathPlanner extends HTMLElement {
     if (!this.hasAttribute('sync-url') || !this.ready) return;
     const q = new URLSearchParams();
     if (this.model && this.model.sample) q.set('model', this.model.sample);
+    else if (this.model && this.model.file) q.set('model', `${FILE_PREFIX}${this.model.file}`);
     const raw = this.#raw();
     for (const p of PARAMS) {
       const v = raw[p.key];

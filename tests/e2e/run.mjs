@@ -87,6 +87,24 @@ function cliPlanAsync(model, { toolRadius, scallop, samples, maxSamples, extra =
 }
 
 // ------------------------------------------------------------------ helpers
+
+/** A small wavy OBJ cage (quads), for opening as a user's file. */
+function extrudedObj() {
+  const lines = [];
+  const [nx, ny] = [7, 4];
+  for (let j = 0; j < ny; j++) {
+    for (let i = 0; i < nx; i++) lines.push(`v ${5 * i} ${6 * j} ${(2 * Math.sin(0.8 * i)).toFixed(6)}`);
+  }
+  for (let j = 0; j + 1 < ny; j++) {
+    for (let i = 0; i + 1 < nx; i++) {
+      const id = (a, b) => b * nx + a + 1;
+      lines.push(`f ${id(i, j)} ${id(i + 1, j)} ${id(i + 1, j + 1)} ${id(i, j + 1)}`);
+    }
+  }
+  return `${lines.join('\n')}\n`;
+}
+
+
 const tests = [];
 const test = (name, fn, opts = {}) => tests.push({ name, fn, opts });
 function check(cond, message) {
@@ -413,8 +431,12 @@ test('heat map overlay from the cutting simulation', async (page, url) => {
   check(await page.isVisible('#heat-legend'), 'the heat legend is shown');
   const legend = await page.textContent('#heat-legend');
   check(/0\.02 mm left/.test(legend) && /gouge/.test(legend), legend);
-  await page.uncheck('#layer-path');
+  // The path would hide the map: it goes with the map shown, and comes back after.
+  check(!(await page.isChecked('#layer-path')), 'the path is hidden under the heat map');
   await page.screenshot({ path: join(shots, 'heat-map.png') });
+  await page.check('#colour-patches');
+  check(await page.isChecked('#layer-path'), 'the path is back with the patch colours');
+  await page.check('#colour-heat');
 
   // A fast plan is redone on change, without pressing Plan.
   const before = await plans(page);
@@ -1410,6 +1432,29 @@ test('inputs: a decimal comma is read as a point, a bad number is echoed, an unk
   const bad = (await page.textContent('#p-scallop-error')).trim();
   check(/“1e”/.test(bad) && /not a number/.test(bad), `“1e” is echoed: ${bad}`);
   return `“0,02” planned as ${h} mm; “1e”: ${bad}; status: ${status.slice(0, 60)}…`;
+});
+
+test('a file model survives a reload; a link to a file this browser does not keep says so', async (page, url) => {
+  await page.goto(`${url}?model=dome`);
+  await waitState(page, 'model-loaded');
+  const obj = extrudedObj();
+  await page.setInputFiles('#file', { name: 'wave-sheet.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
+  const before = await host(page, (el) => el.model.summary);
+  check(new URL(page.url()).searchParams.get('model') === 'file:wave-sheet.obj', `the URL names the file: ${page.url()}`);
+  await page.reload();
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded', HOST, { timeout: 30000 });
+  const after = await host(page, (el) => el.model.summary);
+  check(JSON.stringify(after) === JSON.stringify(before), 'the same model after the reload');
+  // Another browser profile has no such file: it says so and opens the first sample.
+  const other = await page.context().browser().newContext();
+  const p2 = await other.newPage();
+  await p2.goto(`${url}?model=file:somewhere-else.obj`);
+  await p2.waitForSelector(`${HOST}[data-state="model-loaded"]`, { state: 'attached', timeout: 30000 });
+  const st = await p2.locator(`${HOST} >> #status`).textContent();
+  check(/somewhere-else\.obj/.test(st) && /open it again/.test(st), `a file not kept is named: ${st}`);
+  await other.close();
+  return `${after.faces} faces back after the reload; “${st.slice(0, 70)}…”`;
 });
 
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
