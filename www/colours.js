@@ -24,6 +24,9 @@ export const KINDS = [
 ];
 
 export const BACKGROUND = 0xeef1f5;
+/** The program-zero triad: X, Y, Z. */
+export const ZERO_TRIAD = [0xd62728, 0x2ca02c, 0x1f5fd6];
+
 /** Ground of small drawings on the page (the comparison's paths). */
 export const BACKGROUND_LIGHT = 0xf8f9fb;
 export const EP_COLOUR = 0xffd400;

@@ -204,6 +204,7 @@ const TEMPLATE = `
       <label class="inline"><input type="checkbox" id="layer-tool" checked> Tool</label>
       <label class="inline"><input type="checkbox" id="layer-cage"> Control mesh</label>
       <label class="inline"><input type="checkbox" id="layer-eps" checked> Extraordinary points</label>
+      <label class="inline" title="The model's origin: the program's X0 Y0 Z0 in the work offset chosen (X red, Y green, Z blue)"><input type="checkbox" id="layer-zero" checked> Program zero</label>
       <button id="fit" type="button">Fit view</button>
     </div>
     <div class="scrub">
@@ -607,7 +608,7 @@ export class TspathPlanner extends HTMLElement {
     $('params').addEventListener('change', (e) => this.#onParamChange(e.target.name));
     $('params').addEventListener('submit', (e) => e.preventDefault());
     $('fit').addEventListener('click', () => this.view && this.view.fit());
-    for (const k of ['path', 'tool', 'cage', 'eps']) {
+    for (const k of ['path', 'tool', 'cage', 'eps', 'zero']) {
       $(`layer-${k}`).addEventListener('change', () => this.view.setLayers({ [k]: $(`layer-${k}`).checked }));
     }
     $('layer-rest').addEventListener('change', () => {

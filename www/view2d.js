@@ -6,7 +6,7 @@
 // control mesh, the path by kind and the tool as its outline. Same interface as View3D. Z is
 // up; mm.
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, ZERO_TRIAD, heatColour, hexCss, pathColour,
 } from './colours.js';
 
 const rgb = (c) => [c >> 16 & 255, c >> 8 & 255, c & 255];
@@ -28,7 +28,7 @@ export class View2D {
     this.isfc = null;
     this.center = [0, 0, 0];
     this.radius = 1;
-    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true, zero: true };
     this.#bindInput();
     this.resizer = new ResizeObserver(() => this.resize());
     this.resizer.observe(canvas);
@@ -173,6 +173,7 @@ export class View2D {
     if (this.layers.isfc && this.isfc) this.#drawIsfc(proj);
     if (this.layers.rects && this.rects) this.#drawRects(proj);
     if (this.layers.cage) this.#drawCage(proj);
+    if (this.layers.zero) this.#drawZero(proj);
     if (this.layers.eps) this.#drawEps(proj);
     if (this.layers.path && this.path) this.#drawPath(proj);
     if (this.layers.tool && this.tool) this.#drawTool(proj);
@@ -326,6 +327,13 @@ export class View2D {
   #drawRects(proj) {
     this.#segments(proj, this.rects.outlines, () => true, RECT_LAYER.outline, 1, 0.9);
     this.#segments(proj, this.rects.arrows, () => true, RECT_LAYER.arrow, 1.5, 1);
+  }
+
+  /** Program zero: the axis triad at the model's origin (see View3D). */
+  #drawZero(proj) {
+    const len = 0.4 * this.radius;
+    const axes = [[len, 0, 0], [0, len, 0], [0, 0, len]];
+    axes.forEach((a, k) => this.#segments(proj, [0, 0, 0, ...a], () => true, ZERO_TRIAD[k], 2, 1));
   }
 
   #drawCage(proj) {

@@ -7,7 +7,7 @@
 import * as THREE from './vendor/three.module.js';
 import { OrbitControls } from './vendor/OrbitControls.js';
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, ZERO_TRIAD, heatColour, pathColour,
 } from './colours.js';
 
 const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
@@ -30,7 +30,7 @@ export class View3D {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.screenSpacePanning = true;
     this.controls.addEventListener('change', () => this.render());
-    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true };
+    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true, zero: true };
     this.groups = {};
     for (const k of Object.keys(this.layers)) {
       this.groups[k] = new THREE.Group();
@@ -120,6 +120,20 @@ export class View3D {
         inst.setMatrixAt(i, mx.makeTranslation(m.eps[3 * i], m.eps[3 * i + 1], m.eps[3 * i + 2]));
       }
       this.groups.eps.add(inst);
+    }
+    // Program zero: the model's origin, where the work offset puts the program's X0 Y0 Z0;
+    // an axis triad (X red, Y green, Z blue) a fifth of the model's size.
+    {
+      const len = Math.max(size * 0.2, 1e-3);
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array([0, 0, 0, len, 0, 0, 0, 0, 0, 0, len, 0, 0, 0, 0, 0, 0, len]), 3));
+      g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(ZERO_TRIAD.flatMap((c) => {
+        const k = new THREE.Color(c);
+        return [k.r, k.g, k.b, k.r, k.g, k.b];
+      })), 3));
+      const triad = new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false }));
+      triad.renderOrder = 10;
+      this.groups.zero.add(triad);
     }
     if (m.cage.length) {
       const cg = new THREE.BufferGeometry();
@@ -359,7 +373,7 @@ export class View3D {
     this.render();
   }
 
-  /** Shows or hides layers: `{surface, rest, isfc, path, tool, cage, eps}`. */
+  /** Shows or hides layers: `{surface, rest, isfc, rects, path, tool, cage, eps, zero}`. */
   setLayers(layers) {
     Object.assign(this.layers, layers);
     this.render();

@@ -1457,6 +1457,29 @@ test('a file model survives a reload; a link to a file this browser does not kee
   return `${after.faces} faces back after the reload; “${st.slice(0, 70)}…”`;
 });
 
+test('program zero: the triad at the model\'s origin is the program\'s X0 Y0 Z0 (the G-code read back)', async (page, url) => {
+  await page.goto(`${url}?model=bumps&tool-radius=1&scallop=0.1&work-offset=56&${SIM}&plan=1`);
+  await waitPlans(page, 1);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  check(/\nG56\n/.test(g), 'the program runs in G56');
+  // Every block's tool tip is the plan's ball centre less the radius along the axis, in the
+  // model's own coordinates: the program's zero is the model's origin.
+  const p = await host(page, (el) => ({ cl: [...el.plan.cl], kinds: [...el.plan.kinds], r: el.plan.options.tool_radius_mm }));
+  const tips = [];
+  for (let i = 0; i < p.kinds.length; i++) tips.push([p.cl[3 * i], p.cl[3 * i + 1], p.cl[3 * i + 2] - p.r]);
+  const blocks = g.split('\n').filter((l) => /^G[01] X/.test(l)).map((l) => ['X', 'Y', 'Z'].map((k) => Number(l.match(new RegExp(`${k}(-?[0-9.]+)`))[1])));
+  let worst = 0;
+  blocks.forEach((b) => {
+    const near = Math.min(...tips.map((t) => Math.hypot(t[0] - b[0], t[1] - b[1], t[2] - b[2])));
+    worst = Math.max(worst, near);
+  });
+  check(blocks.length > 100 && worst < 1e-4, `${blocks.length} blocks, each within ${worst.toExponential(1)} mm of a planned tip`);
+  const px = await host(page, (el) => el.layerPixels('zero'));
+  check(px > 30, `the triad is drawn (${px} px)`);
+  return `G56; ${blocks.length} blocks at the planned tips (worst ${worst.toExponential(1)} mm); triad ${px} px`;
+});
+
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
   const axePath = join(root, 'tests', 'e2e', 'node_modules', 'axe-core', 'axe.min.js');
   const audit = async (what) => {
