@@ -402,15 +402,7 @@ pub fn post_program(
             return Err(Error::param(name, format!("must be positive, got {v}")));
         }
     }
-    if !(54..=59).contains(&opts.work_offset) {
-        return Err(Error::param(
-            "work_offset",
-            format!(
-                "must be one of 54 to 59 (G54–G59), got {}",
-                opts.work_offset
-            ),
-        ));
-    }
+    opts.check_work_offset()?;
     let r = path.tool_radius_mm;
     let five = machine.kinematics() != Kinematics::ThreeAxis;
     let mode = match (five, dialect) {

@@ -432,7 +432,6 @@ const COLUMNS: &[Column] = &[
     }),
     ("cut ÷ L_min", |r| format!("{:.3}", r.efficiency)),
     ("cut ÷ flat L_min", |r| format!("{:.3}", r.efficiency_flat)),
-    ("status", |r| status_text(r)),
 ];
 
 fn status_text(r: &StrategyRun) -> String {
@@ -460,9 +459,7 @@ impl Comparison {
                         f(r)
                     });
                 }
-                if let Some(last) = row.last_mut() {
-                    *last = status_text(r);
-                }
+                row.push(status_text(r));
                 row
             })
             .collect()
@@ -471,6 +468,7 @@ impl Comparison {
     fn headings() -> Vec<&'static str> {
         std::iter::once("strategy")
             .chain(COLUMNS.iter().map(|c| c.0))
+            .chain(std::iter::once("status"))
             .collect()
     }
 

@@ -284,15 +284,7 @@ impl PlanOptions {
         positive("feed_mm_min", self.feed_mm_min, "mm/min")?;
         positive("plunge_feed_mm_min", self.plunge_feed_mm_min, "mm/min")?;
         positive("spindle_rpm", self.spindle_rpm, "rev/min")?;
-        if !(54..=59).contains(&self.work_offset) {
-            return Err(Error::param(
-                "work_offset",
-                format!(
-                    "must be one of 54 to 59 (G54–G59), got {}",
-                    self.work_offset
-                ),
-            ));
-        }
+        self.check_work_offset()?;
         positive("shank_length_mm", self.shank_length_mm, "mm")?;
         positive("holder_radius_mm", self.holder_radius_mm, "mm")?;
         positive("holder_length_mm", self.holder_length_mm, "mm")?;
@@ -381,3 +373,21 @@ pub const MAX_OVERCUT_MM: f64 = 0.002;
 /// from below the horizontal, as a swivelling table tilted past upright presents a part's
 /// underside; the machine's own limits then decide (its post says which axis overruns).
 pub const MAX_TILT_DEG: f64 = 135.0;
+
+impl PlanOptions {
+    /// Checks the work offset alone (the post writes programs from options it does not
+    /// otherwise re-check).
+    pub fn check_work_offset(&self) -> Result<()> {
+        if (54..=59).contains(&self.work_offset) {
+            Ok(())
+        } else {
+            Err(Error::param(
+                "work_offset",
+                format!(
+                    "must be one of 54 to 59 (G54–G59), got {}",
+                    self.work_offset
+                ),
+            ))
+        }
+    }
+}
