@@ -17,6 +17,7 @@ const USAGE: &str = "usage:
   tspath plan MODEL [--strategy isoparametric|isfc|watershed|multi-rectangle|isoplanar]
               [--isfc-plain] [--slice-angle DEG] [--no-deform] [--shear]
               [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
+              [--plunge-feed MM_PER_MIN] [--clearance MM] [--feed-height MM]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--axis-preset vertical|gan2014|yuan2012]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
@@ -44,6 +45,9 @@ that reads a MODEL places it with [--model-units mm|cm|m|inch] (the unit of a fi
 does not say its own, OBJ; default mm) [--scale F] [--up z|y] (y: the file's +Y becomes +Z,
 as modelling tools write) [--rotate 0|90|180|270] (about +Z, counter-clockwise from above)
 [--on-table] (lowest point at Z 0); `info` shows the placement and the millimetre box.
+--clearance is the safe plane's height above the model (default 5 mm); the tool rapids
+down to --feed-height above each cut (default 2 mm, along its way down) and goes on at
+--plunge-feed (default 300 mm/min).
 --axis-preset gan2014 leads the tool 10° from the surface normal along the feed, as the
 space-filling-curve paper machined (five-axis machines); --lead/--tilt after it override.
 --machine is a built-in machine (default 3-axis) or a machine JSON file (start from
@@ -312,6 +316,9 @@ const PLAN_FLAGS: &[&str] = &[
     "--scallop",
     "--chordal",
     "--feed",
+    "--plunge-feed",
+    "--clearance",
+    "--feed-height",
     "-o",
     "--report",
     "--verify-samples",
@@ -353,6 +360,15 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     }
     if let Some(v) = a.number("--feed")? {
         opts.feed_mm_min = v;
+    }
+    if let Some(v) = a.number("--plunge-feed")? {
+        opts.plunge_feed_mm_min = v;
+    }
+    if let Some(v) = a.number("--clearance")? {
+        opts.clearance_mm = v;
+    }
+    if let Some(v) = a.number("--feed-height")? {
+        opts.feed_height_mm = v;
     }
     if let Some(w) = a.value("--work-offset") {
         let n = w.trim_start_matches(['G', 'g']);

@@ -277,3 +277,93 @@ fn rs274_rejects_broken_programs() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 18: the plunge comes down fast to a feed height, then at the plunge feed. Read by
+/// LinuxCNC's interpreter: after every run of rapids, the moves at the plunge feed cover
+/// exactly the feed height (along the way down), as many as the path's approach and plunge
+/// moves, and the cut after them runs at the cutting feed.
+#[test]
+fn rs274_sees_every_approach_slow_down_at_the_feed_height() {
+    let dir = scratch("rs274-feed-height");
+    let mach = machine::builtin("3-axis").unwrap();
+    let mut approaches = 0;
+    let isoplanar = tspath::plan::Strategy::Isoplanar;
+    let isoparametric = tspath::plan::Strategy::Isoparametric;
+    for (name, strategy, feed_height) in [
+        ("keycap-convex", isoparametric, 2.0),
+        ("dome", isoparametric, 3.5),
+        ("bumps-hole", isoplanar, 0.7),
+    ] {
+        let m = tspath::model::samples::load_sample(name).unwrap();
+        let o = opts_for(name)
+            .with_feed_height(feed_height)
+            .with_strategy(strategy);
+        let path = tspath::plan::plan(&m, &o, &mut |_| true).unwrap().toolpath;
+        // Moves at the plunge feed per approach, in the planned path.
+        let mut planned: Vec<usize> = Vec::new();
+        for (i, mv) in path.moves.iter().enumerate() {
+            if mv.kind.at_plunge_feed() && (i == 0 || !path.moves[i - 1].kind.at_plunge_feed()) {
+                planned.push(0);
+            }
+            if mv.kind.at_plunge_feed() {
+                *planned.last_mut().unwrap() += 1;
+            }
+        }
+        let text = post(&path, &o, &job(name), &mach, Dialect::LinuxCnc, Units::Mm).unwrap();
+        let file = dir.join(format!("{name}.ngc"));
+        std::fs::write(&file, &text).unwrap();
+        let run = rs274(&file, path.tool_radius_mm);
+        assert!(run.accepted, "{name}: {}", run.message);
+        // Walk the canonical commands: feed rate, rapids, feeds.
+        let mut rate = 0.0;
+        let mut at = [0.0; 3];
+        let mut seen: Vec<(usize, f64)> = Vec::new(); // (moves, length) at the plunge feed
+        let mut after_rapid = false;
+        for l in run.stdout.lines() {
+            if let Some(i) = l.find("SET_FEED_RATE(") {
+                let v = &l[i + "SET_FEED_RATE(".len()..];
+                rate = v.trim_end().trim_end_matches(')').parse().unwrap();
+                continue;
+            }
+            let Some((feed, xyz)) = canonical_moves(l)
+                .first()
+                .map(|(f, v)| (*f, [v[0], v[1], v[2]]))
+            else {
+                continue;
+            };
+            let len = (0..3).map(|k| (xyz[k] - at[k]).powi(2)).sum::<f64>().sqrt();
+            at = xyz;
+            if !feed {
+                after_rapid = true;
+                continue;
+            }
+            if after_rapid {
+                assert_eq!(
+                    rate, o.plunge_feed_mm_min,
+                    "{name}: the first feed after rapids"
+                );
+                seen.push((0, 0.0));
+                after_rapid = false;
+            }
+            if rate == o.plunge_feed_mm_min {
+                let s = seen.last_mut().expect("a plunge-feed move after rapids");
+                s.0 += 1;
+                s.1 += len;
+            } else {
+                assert_eq!(rate, o.feed_mm_min, "{name}");
+            }
+        }
+        assert_eq!(seen.len(), planned.len(), "{name}: approaches");
+        for (k, ((moves, len), want)) in seen.iter().zip(&planned).enumerate() {
+            assert_eq!(moves, want, "{name} approach {k}: moves at the plunge feed");
+            // rs274 prints 4 decimals: each of the few moves may be off by √3·0.5e-4.
+            assert!(
+                (len - feed_height).abs() < 1e-3,
+                "{name} approach {k}: {len} mm at the plunge feed, feed height {feed_height} mm"
+            );
+        }
+        approaches += seen.len();
+    }
+    println!("rs274: {approaches} approaches, each fed over exactly its feed height");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

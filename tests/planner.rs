@@ -553,7 +553,8 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
     let path = &planned.toolpath;
     let air = planned.air;
     assert_eq!(air.blocked, 0);
-    // Rapids down beside the head (and in under it), then the plunge onto the cut.
+    // Rapids down beside the head (and in under it), the approach from the feed height,
+    // then the plunge onto the cut.
     let plunge = path
         .moves
         .iter()
@@ -563,7 +564,7 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
         plunge >= 2
             && path.moves[..plunge]
                 .iter()
-                .all(|m| m.kind == MoveKind::Rapid),
+                .all(|m| matches!(m.kind, MoveKind::Rapid | MoveKind::Approach)),
         "the approach comes down beside the head and plunges from there: {:?}",
         path.moves[..=plunge]
             .iter()
@@ -581,8 +582,10 @@ fn air_moves_keep_the_ball_out_of_the_closed_head() {
     let mut least = f64::INFINITY;
     let mut checked = 0;
     for (i, w) in path.moves.windows(2).enumerate() {
-        let air_move = matches!(w[1].kind, MoveKind::Retract | MoveKind::Rapid)
-            || (w[1].kind == MoveKind::Plunge && w[0].kind == MoveKind::Rapid);
+        let air_move = matches!(
+            w[1].kind,
+            MoveKind::Retract | MoveKind::Rapid | MoveKind::Approach
+        ) || (w[1].kind == MoveKind::Plunge && !w[0].kind.on_surface());
         if !air_move {
             continue;
         }
@@ -730,8 +733,10 @@ fn air_moves_keep_shank_and_holder_out_of_the_head() {
         let mut least = reach;
         let mut checked = 0;
         for w in planned.toolpath.moves.windows(2) {
-            let air = matches!(w[1].kind, MoveKind::Retract | MoveKind::Rapid)
-                || (w[1].kind == MoveKind::Plunge && w[0].kind == MoveKind::Rapid);
+            let air = matches!(
+                w[1].kind,
+                MoveKind::Retract | MoveKind::Rapid | MoveKind::Approach
+            ) || (w[1].kind == MoveKind::Plunge && !w[0].kind.on_surface());
             if !air {
                 continue;
             }

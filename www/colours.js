@@ -21,6 +21,7 @@ export const KINDS = [
   { name: 'retract', label: 'retraction', colour: 0xd62728, dashed: true },
   { name: 'rapid', label: 'rapid above the model', colour: 0xd62728, dashed: true },
   { name: 'plunge', label: 'plunge onto the surface', colour: 0xff7f0e, dashed: false },
+  { name: 'approach', label: 'approach from the feed height, at the plunge feed', colour: 0xff7f0e, dashed: true },
 ];
 
 export const BACKGROUND = 0xeef1f5;

@@ -7,7 +7,7 @@
 // the page cancels by terminating this worker and starting a new one (see client.js).
 import { engineInfo, loadBytes, loadSample } from './engine.js';
 
-const KIND_NAMES = ['feed', 'link', 'retract', 'rapid', 'plunge'];
+const KIND_NAMES = ['feed', 'link', 'retract', 'rapid', 'plunge', 'approach'];
 /** Least progress interval posted to the page (ms): enough for a smooth bar. */
 const PROGRESS_INTERVAL_MS = 40;
 

@@ -28,7 +28,7 @@
 
 use super::joints;
 use super::kinematics::Machine;
-use crate::plan::{MoveKind, PlanOptions, Toolpath};
+use crate::plan::{PlanOptions, Toolpath};
 use serde::{Deserialize, Serialize};
 
 /// Seconds per minute.
@@ -347,11 +347,7 @@ pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> Pat
                 linear_mm,
                 rotary_deg,
                 tip_length_mm: tip.norm(),
-                feed_mm_min: match b.kind {
-                    MoveKind::Feed | MoveKind::Link => Some(opts.feed_mm_min),
-                    MoveKind::Plunge => Some(opts.plunge_feed_mm_min),
-                    MoveKind::Retract | MoveKind::Rapid => None,
-                },
+                feed_mm_min: opts.feed_for(b.kind),
             }
         })
         .collect();

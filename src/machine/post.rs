@@ -26,7 +26,7 @@ use super::kinematics::{Joints, Kinematics, Machine};
 use super::JobInfo;
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
-use crate::plan::{MoveKind, PlanOptions, Toolpath};
+use crate::plan::{PlanOptions, Toolpath};
 use std::fmt::Write;
 
 /// Millimetres per inch.
@@ -626,7 +626,7 @@ pub fn post_program(
     }
     let mut emits: Vec<Emit> = Vec::with_capacity(path.moves.len());
     for (i, m) in path.moves.iter().enumerate() {
-        let cutting = !matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+        let cutting = !m.kind.rapid();
         if mode == OutputMode::Joints && cutting && i > 0 {
             let prev = &path.moves[i - 1];
             let way = |m: &crate::plan::Move, k: usize| joints::Waypoint {
@@ -667,7 +667,7 @@ pub fn post_program(
     let mut spindle_extra = syntax == Syntax::Heidenhain;
     for e in &emits {
         let m = &path.moves[e.i];
-        let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+        let rapid = m.kind.rapid();
         let rotary = rot_words(&e.joints);
         let rot_text: Vec<String> = rotary.iter().map(|(_, v)| o.deg(*v)).collect();
         let rot_moves = rot_text != last_rot_text;
@@ -693,12 +693,7 @@ pub fn post_program(
                 Source::Move(e.i)
             },
         };
-        if !rapid {
-            let feed_mm_min = if m.kind == MoveKind::Plunge {
-                opts.plunge_feed_mm_min
-            } else {
-                opts.feed_mm_min
-            };
+        if let Some(feed_mm_min) = opts.feed_for(m.kind) {
             let len = last_tip.map(|p| (e.tip - p).norm()).unwrap_or(0.0);
             let turn = last_rot
                 .map(|p| {
@@ -763,7 +758,7 @@ pub fn post_program(
             .moves
             .iter()
             .zip(&tips)
-            .filter(|(m, _)| !matches!(m.kind, MoveKind::Rapid | MoveKind::Retract))
+            .filter(|(m, _)| m.kind.on_surface())
             .map(|(_, t)| (t - tip).dot(&v))
             .fold(f64::NEG_INFINITY, f64::max);
         let d = highest + opts.clearance_mm;

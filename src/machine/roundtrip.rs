@@ -12,7 +12,7 @@ use super::reader::{self, FeedMode, Program, ProgramMove};
 use super::JobInfo;
 use crate::error::{Error, Result};
 use crate::geom::Vector3;
-use crate::plan::{MoveKind, PlanOptions, Toolpath};
+use crate::plan::{PlanOptions, Toolpath};
 use serde::{Deserialize, Serialize};
 
 /// Inverse-time moves at least this long (mm) have their implied feed checked. The implied
@@ -231,10 +231,7 @@ pub fn compare(
             out.max_position_error_mm = e_pos;
             out.worst_position_move = i;
         }
-        let planned_feed = match planned.kind {
-            MoveKind::Plunge => opts.plunge_feed_mm_min,
-            _ => opts.feed_mm_min,
-        };
+        let planned_feed = opts.feed_for(planned.kind).unwrap_or(opts.feed_mm_min);
         let feed_err = match read.feed_mode {
             FeedMode::Rapid => None,
             FeedMode::PerMinute => Some((read.feed - planned_feed).abs() / planned_feed),

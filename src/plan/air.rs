@@ -215,21 +215,78 @@ pub fn route(
         let m = old.moves[i];
         let param = old.param(i);
         let mut push = |mv: Move| add(mv, param);
-        match &legs[i] {
-            Some((_, leg, Some(way))) if way.len() > 1 => {
-                stats.escaped += 1;
-                let mut points = way.clone();
-                if *leg == Leg::Arriving {
-                    points.reverse();
-                }
-                for p in points {
-                    push(Move { cl_point: p, ..m });
+        let Some((cut, leg, Some(way))) = &legs[i] else {
+            push(m);
+            return;
+        };
+        if way.len() > 1 {
+            stats.escaped += 1;
+        }
+        match leg {
+            Leg::Leaving => {
+                for p in way {
+                    push(Move { cl_point: *p, ..m });
                 }
             }
-            _ => push(m),
+            Leg::Arriving => {
+                let down: Vec<Point3> = way.iter().rev().copied().collect();
+                let (rapid, fed) =
+                    split_at_feed_height(&down, &old.moves[*cut].cl_point, opts.feed_height_mm);
+                for p in rapid {
+                    push(Move { cl_point: p, ..m });
+                }
+                for p in fed {
+                    push(Move {
+                        kind: MoveKind::Approach,
+                        cl_point: p,
+                        ..m
+                    });
+                }
+            }
         }
     });
     Routed::Done(stats)
+}
+
+/// Points closer than this are one point when the feed height falls on a corner of the
+/// way down (mm).
+const SAME_POINT_MM: f64 = 1e-6;
+
+/// Splits the way down to a cut (`down`: from the safe plane to the last point before the
+/// cut at `cut`) where it is `feed_height` from the cut, measured along the way: the points
+/// the tool reaches at the rapid rate (the last one at the feed height), and those after it
+/// that it reaches at the plunge feed (the cut itself, reached by the plunge, not included).
+/// A way shorter than the feed height is fed from its first point on.
+fn split_at_feed_height(
+    down: &[Point3],
+    cut: &Point3,
+    feed_height: f64,
+) -> (Vec<Point3>, Vec<Point3>) {
+    if feed_height <= SAME_POINT_MM || down.is_empty() {
+        return (down.to_vec(), Vec::new());
+    }
+    let mut left = feed_height;
+    let mut to = *cut;
+    for j in (0..down.len()).rev() {
+        if left <= SAME_POINT_MM {
+            // The feed height is on the corner `down[j + 1]`.
+            return (down[..j + 2].to_vec(), down[j + 2..].to_vec());
+        }
+        let from = down[j];
+        let len = (to - from).norm();
+        if len > left {
+            // The feed height lies on the leg from `down[j]` to `to`.
+            let at = to + (from - to) * (left / len);
+            let mut rapid = down[..=j].to_vec();
+            if (at - from).norm() > SAME_POINT_MM {
+                rapid.push(at);
+            }
+            return (rapid, down[j + 1..].to_vec());
+        }
+        left -= len;
+        to = from;
+    }
+    (down[..1].to_vec(), down[1..].to_vec())
 }
 
 #[cfg(test)]
@@ -251,5 +308,32 @@ mod tests {
         let d = Vector3::new(1.0, 0.0, 1.0).normalize();
         let e = b.exit(&p, &d);
         assert!((e - Point3::new(3.0, 0.0, 4.0)).norm() < 1e-12, "{e}");
+    }
+
+    #[test]
+    fn the_rapid_stops_at_the_feed_height_measured_along_the_way_down() {
+        let cut = Point3::new(0.0, 0.0, 0.0);
+        let lead = Point3::new(0.1, 0.0, 0.0);
+        let safe = Point3::new(0.1, 0.0, 10.0);
+        // Down from the safe plane to the lead-off point, then across onto the cut: the
+        // 2 mm are 0.1 mm across and 1.9 mm of the vertical leg.
+        let (rapid, fed) = split_at_feed_height(&[safe, lead], &cut, 2.0);
+        assert_eq!(rapid.len(), 2);
+        assert!((rapid[1] - Point3::new(0.1, 0.0, 1.9)).norm() < 1e-12);
+        assert_eq!(fed, vec![lead]);
+        // Straight down: the rapid ends 2 mm above the cut, nothing else is fed.
+        let above = Point3::new(0.0, 0.0, 10.0);
+        let (rapid, fed) = split_at_feed_height(&[above], &cut, 2.0);
+        assert_eq!(rapid, vec![above, Point3::new(0.0, 0.0, 2.0)]);
+        assert!(fed.is_empty());
+        // A way shorter than the feed height is fed from the safe plane on.
+        let (rapid, fed) = split_at_feed_height(&[safe, lead], &cut, 20.0);
+        assert_eq!((rapid, fed), (vec![safe], vec![lead]));
+        // Feed height 0: the rapid goes all the way down, as the way was.
+        let (rapid, fed) = split_at_feed_height(&[safe, lead], &cut, 0.0);
+        assert_eq!((rapid, fed), (vec![safe, lead], vec![]));
+        // The feed height on a corner of the way: no point repeated.
+        let (rapid, fed) = split_at_feed_height(&[safe, lead], &cut, 0.1);
+        assert_eq!((rapid, fed), (vec![safe, lead], vec![]));
     }
 }

@@ -2,6 +2,7 @@
 //! in the unit its name says, each default chosen to work on every sample model.
 
 use super::corners::Crossfeed;
+use super::toolpath::MoveKind;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -28,6 +29,11 @@ pub struct PlanOptions {
     pub feed_mm_min: f64,
     /// Feed for plunging into the first cut (mm/min). Default 300 mm/min.
     pub plunge_feed_mm_min: f64,
+    /// Feed height: how far above the first point of a cut (measured along the way down
+    /// to it) the rapid approach stops and the tool goes on at the plunge feed (mm).
+    /// Default 2 mm, room for a stock allowance or a mis-set tool length to meet the tool
+    /// at a feed, not at the rapid rate.
+    pub feed_height_mm: f64,
     /// Spindle speed (rev/min). Default 12000 rpm.
     pub spindle_rpm: f64,
     /// Work offset the program runs in: 54 to 59 for G54–G59 (Heidenhain: preset 1–6,
@@ -158,6 +164,7 @@ impl Default for PlanOptions {
             clearance_mm: 5.0,
             feed_mm_min: 1000.0,
             plunge_feed_mm_min: 300.0,
+            feed_height_mm: 2.0,
             spindle_rpm: 12000.0,
             work_offset: 54,
             start_patch: None,
@@ -208,6 +215,22 @@ impl PlanOptions {
     pub fn with_feed(mut self, mm_min: f64) -> Self {
         self.feed_mm_min = mm_min;
         self
+    }
+    /// Sets the feed height above the first point of each cut (mm).
+    pub fn with_feed_height(mut self, mm: f64) -> Self {
+        self.feed_height_mm = mm;
+        self
+    }
+
+    /// The feed a move of this kind runs at (mm/min); `None` for rapid moves.
+    pub fn feed_for(&self, kind: MoveKind) -> Option<f64> {
+        if kind.rapid() {
+            None
+        } else if kind.at_plunge_feed() {
+            Some(self.plunge_feed_mm_min)
+        } else {
+            Some(self.feed_mm_min)
+        }
     }
 
     /// Sets the shank and holder (mm).
@@ -283,6 +306,16 @@ impl PlanOptions {
         positive("clearance_mm", self.clearance_mm, "mm")?;
         positive("feed_mm_min", self.feed_mm_min, "mm/min")?;
         positive("plunge_feed_mm_min", self.plunge_feed_mm_min, "mm/min")?;
+        if !(self.feed_height_mm.is_finite() && self.feed_height_mm >= 0.0) {
+            return Err(Error::param(
+                "feed_height_mm",
+                format!(
+                    "must be 0 mm or more (the height above a cut where the rapid approach \
+                     stops), got {}",
+                    self.feed_height_mm
+                ),
+            ));
+        }
         positive("spindle_rpm", self.spindle_rpm, "rev/min")?;
         self.check_work_offset()?;
         positive("shank_length_mm", self.shank_length_mm, "mm")?;

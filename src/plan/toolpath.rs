@@ -16,16 +16,30 @@ pub enum MoveKind {
     Link = 1,
     /// Leaving the surface along the tool axis to the safe plane.
     Retract = 2,
-    /// Rapid move above the model (or down to just above the first cut).
+    /// Rapid move above the model, or down to the feed height above the next cut.
     Rapid = 3,
-    /// Feed move from the approach point onto the surface.
+    /// Feed move from the approach point onto the surface, at the plunge feed.
     Plunge = 4,
+    /// Feed move in the air, at the plunge feed, from the feed height down towards the next
+    /// cut (the ways round the model that lead onto it); a plunge follows.
+    Approach = 5,
 }
 
 impl MoveKind {
     /// True for moves that end with the ball on the surface (cutting, linking, plunging).
     pub fn on_surface(self) -> bool {
         matches!(self, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge)
+    }
+
+    /// True for moves at the rapid rate (retracts and rapids); the others run at a feed.
+    pub fn rapid(self) -> bool {
+        matches!(self, MoveKind::Retract | MoveKind::Rapid)
+    }
+
+    /// True for the feed moves that bring the tool down onto a cut (the in-air approach
+    /// and the plunge), run at the plunge feed.
+    pub fn at_plunge_feed(self) -> bool {
+        matches!(self, MoveKind::Approach | MoveKind::Plunge)
     }
 }
 
@@ -356,7 +370,7 @@ impl Toolpath {
                     r.link_length_mm += len;
                     r.feed_time_min += len / feed;
                 }
-                MoveKind::Plunge => {
+                MoveKind::Plunge | MoveKind::Approach => {
                     r.link_length_mm += len;
                     r.feed_time_min += len / plunge_feed;
                 }

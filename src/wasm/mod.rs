@@ -528,7 +528,8 @@ impl WasmPlan {
             .collect();
         js_sys::Float64Array::from(&v[..])
     }
-    /// Move kind per move: 0 feed, 1 link, 2 retract, 3 rapid, 4 plunge.
+    /// Move kind per move: 0 feed, 1 link, 2 retract, 3 rapid, 4 plunge, 5 approach (in the air
+    /// at the plunge feed, from the feed height).
     #[wasm_bindgen(js_name = moveKinds)]
     pub fn move_kinds(&self) -> js_sys::Uint8Array {
         let v: Vec<u8> = self.path.moves.iter().map(|m| m.kind as u8).collect();
