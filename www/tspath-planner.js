@@ -13,6 +13,7 @@
 // plan's report says (`planned`, or `planned_with_problems` when it leaves something undone);
 // `data-verify` whether the cutting simulation is running, done or failed; `data-stale`
 // that the parameters no longer match the plan shown (its downloads are off).
+import { JOB_SUFFIX, isJob, readJob, writeJob } from './job.js';
 import { CancelledError, EngineClient } from './client.js';
 import { loadLastFile, saveLastFile } from './storage.js';
 import {
@@ -165,8 +166,11 @@ const TEMPLATE = `
       <h2>Model</h2>
       <label for="sample">Built-in sample or public model</label>
       <select id="sample"></select>
-      <label for="file">Open a model file (.tsm, .obj, .json) — or drop it on the view</label>
+      <label for="file">Open a model file (.tsm, .obj, .json) or a saved job — or drop it on the view</label>
       <input id="file" type="file" accept=".json,.tsm,.obj">
+      <div class="job-buttons">
+        <button id="save-job" type="button" disabled title="One file with the model and every parameter: open it again here, on any machine, for the same plan">Save job</button>
+      </div>
       <dl id="summary" class="facts" aria-label="Model summary"></dl>
       <p id="concave-hint" class="hint"></p>
       <div id="patch-legend" class="legend" aria-label="Patch colours"></div>
@@ -321,6 +325,12 @@ function rawStat(id, r, v) {
   if (id in r) return r[id];
   if (v && id in v) return v[id];
   return '';
+}
+
+/** A parameter's default as its control shows it. */
+function defaultText(p) {
+  if (p.kind === 'flag') return p.default ? '1' : '0';
+  return p.default === null || p.default === undefined ? '' : String(p.default);
 }
 
 function download(name, data, type) {
@@ -632,6 +642,7 @@ export class TspathPlanner extends HTMLElement {
     $('download-gcode').addEventListener('click', () => this.#downloadGcode());
     $('download-csv').addEventListener('click', () => this.#downloadCsv());
     $('download-stl').addEventListener('click', () => this.#downloadStl());
+    $('save-job').addEventListener('click', () => this.#saveJob());
     // Drag and drop anywhere on the element.
     let depth = 0;
     this.addEventListener('dragenter', (e) => {
@@ -713,6 +724,51 @@ export class TspathPlanner extends HTMLElement {
     return this.#load({ bytes: buf, name: m.file.replace(/\.[^.]*$/, '') }, m.file, m);
   }
 
+  /** Opens a job file (see job.js): its parameters set, its model loaded, and planned when
+   * it was saved planned. */
+  async #openJob(text, name) {
+    let job;
+    try {
+      job = readJob(text);
+    } catch (e) {
+      this.#status(`Could not open the job ${name}: ${e.message}.`, true);
+      return false;
+    }
+    const unknown = Object.keys(job.parameters).filter((k) => !byKey[k]);
+    for (const p of PARAMS) this.#setControl(p, job.parameters[p.key] ?? defaultText(p));
+    this.pendingPatches = { 'start-patch': job.parameters['start-patch'], 'finish-patch': job.parameters['finish-patch'] };
+    this.#updateDependentControls();
+    this.#validateAll();
+    const m = job.model;
+    const loaded = m.sample
+      ? await this.#loadNamed(m.sample)
+      : await this.#load({ bytes: m.bytes, name: m.file.replace(/\.[^.]*$/, '') }, m.file);
+    if (!loaded) return false;
+    if (unknown.length) {
+      this.#status(`Opened the job ${name}, but its ${unknown.map((k) => `“${k}”`).join(', ')} ${unknown.length === 1 ? 'is not a parameter' : 'are not parameters'} of this page (left out): check the parameters, then plan.`, 'warning');
+      return true;
+    }
+    if (job.planned && !this.#validateAll().errors) await this.#plan();
+    else if (!this.#validateAll().errors) this.#status(`Opened the job ${name}: ${this.model.summary.name} with the parameters saved. Press “Plan tool path” to plan it.`);
+    return true;
+  }
+
+  /** Saves the job: the model (a file's bytes with it) and every parameter, planned or not. */
+  #saveJob() {
+    const m = this.model;
+    if (!m) return;
+    let model;
+    if (m.sample) model = { sample: m.sample };
+    else if (this.client.source?.bytes) model = { file: m.file, bytes: this.client.source.bytes };
+    else {
+      this.#status('Could not save the job: the model file is no longer held by the page; open it again, then save.', true);
+      return;
+    }
+    const planned = !!this.plan && this.#planMatches();
+    const text = writeJob({ model, parameters: this.#raw(), planned, savedBy: `tspath ${this.info?.version ?? ''}`.trim() });
+    download(`${this.#baseName()}${JOB_SUFFIX}`, text, 'application/json');
+  }
+
   async #openFile(file) {
     const ext = (file.name.match(/\.[^.]*$/) || [''])[0].toLowerCase();
     if (file.size > MAX_FILE_BYTES) {
@@ -724,6 +780,10 @@ export class TspathPlanner extends HTMLElement {
       return false;
     }
     const buf = await file.arrayBuffer();
+    if (ext === '.json') {
+      const text = new TextDecoder().decode(buf);
+      if (isJob(text)) return this.#openJob(text, file.name);
+    }
     const stem = file.name.replace(/\.[^.]*$/, '');
     return this.#load({ bytes: buf, name: stem }, file.name);
   }
@@ -762,7 +822,7 @@ export class TspathPlanner extends HTMLElement {
     this.$('colour-patches').checked = true;
     this.$('sample').value = sample ?? '';
     this.#showSummary(m.summary, pub);
-    this.#fillPatchChoices(m.summary.patches);
+    const patchNote = this.#fillPatchChoices(m.summary.patches);
     this.view.setModel(m);
     this.#showColours();
     this.view.renderNow();
@@ -770,13 +830,15 @@ export class TspathPlanner extends HTMLElement {
       this.dataset.firstDrawMs = String(Math.round(performance.now() - this.t0));
     }
     this.$('download-stl').disabled = false;
+    this.$('save-job').disabled = false;
     this.state = 'model-loaded';
     this.dataset.model = m.summary.name;
     this.dataset.meshChordalMm = String(m.chordal_mm);
     const { errors } = this.#validateAll();
     // A wrong value from the URL or an attribute is said at once, not only at its field.
     const patches = `${int(m.summary.patches)} ${m.summary.patches === 1 ? 'patch' : 'patches'}`;
-    if (errors) this.#status(`Loaded ${m.summary.name}: ${patches}. Before planning: ${errors[0]}`, true);
+    if (errors) this.#status(`Loaded ${m.summary.name}: ${patches}. Before planning: ${errors[0]}${patchNote}`, true);
+    else if (patchNote) this.#status(`Loaded ${m.summary.name}: ${patches}.${patchNote}`, 'warning');
     else this.#status(`Loaded ${m.summary.name}: ${patches}. Choose parameters and plan.`);
     this.#syncUrl();
     return true;
@@ -874,15 +936,22 @@ export class TspathPlanner extends HTMLElement {
     }
   }
 
+  /** Offers the patches of a model of `n`; a patch asked for (URL, attribute, job) that the
+   * model does not have is left at auto, and the returned text says so. */
   #fillPatchChoices(n) {
+    const dropped = [];
     for (const key of ['start-patch', 'finish-patch']) {
       const el = this.$(`p-${key}`);
       const wanted = this.pendingPatches?.[key] ?? ''; // a new model's patches are not the old one's
       el.replaceChildren(new Option(`auto (${byKey[key].auto})`, ''));
       for (let i = 0; i < n; i++) el.append(new Option(`patch ${i}`, String(i)));
-      el.value = wanted !== '' && Number(wanted) < n ? String(wanted) : '';
+      const ok = wanted !== '' && /^\d+$/.test(String(wanted)) && Number(wanted) < n;
+      el.value = ok ? String(wanted) : '';
+      if (wanted !== '' && !ok) dropped.push(`${byKey[key].label.toLowerCase()} “${wanted}”`);
     }
     this.pendingPatches = null;
+    if (!dropped.length) return '';
+    return ` The ${dropped.join(' and ')} ${dropped.length === 1 ? 'is' : 'are'} not a patch of this model (patches 0 to ${n - 1}): left at auto.`;
   }
 
   // ---------------------------------------------------------------- parameters
@@ -1152,7 +1221,9 @@ export class TspathPlanner extends HTMLElement {
     await this.#post();
     this.lastPlanMs = performance.now() - t0;
     this.dataset.plans = String(Number(this.dataset.plans || 0) + 1);
-    this.#scrubTo(0);
+    // Where the slider is: 0 for a new plan, unless it was moved while the program was
+    // being written.
+    this.#scrubTo(Number(this.$('scrub').value));
     this.#syncUrl();
     const again = this.replanAfter && !this.#planMatches();
     this.replanAfter = false;
@@ -2024,7 +2095,7 @@ export class TspathPlanner extends HTMLElement {
     const raw = this.#raw();
     for (const p of PARAMS) {
       const v = raw[p.key];
-      const d = p.kind === 'flag' ? (p.default ? '1' : '0') : p.default === null ? '' : String(p.default);
+      const d = defaultText(p);
       if (v !== '' && v !== d && !(p.kind === 'number' && Number(v) === Number(d) && d !== '')) q.set(p.key, v);
     }
     if (this.plan) q.set('plan', '1');

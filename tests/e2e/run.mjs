@@ -1415,7 +1415,7 @@ test('without WebGL the 2D view draws the regions and rectangles', async (page, 
   return `${px} px`;
 }, { noWebGL: true });
 
-test('inputs: a decimal comma is read as a point, a bad number is echoed, an unknown URL parameter is named', async (page, url) => {
+test('inputs: a decimal comma is read as a point, a bad number is echoed, an unknown URL parameter and a missing start patch are named', async (page, url) => {
   await page.goto(`${url}?model=dome&scalop=0.1&tool-radius=1`);
   await waitState(page, 'model-loaded');
   const status = await page.textContent('#status');
@@ -1431,7 +1431,14 @@ test('inputs: a decimal comma is read as a point, a bad number is echoed, an unk
   await setParam(page, 'scallop', '1e');
   const bad = (await page.textContent('#p-scallop-error')).trim();
   check(/“1e”/.test(bad) && /not a number/.test(bad), `“1e” is echoed: ${bad}`);
-  return `“0,02” planned as ${h} mm; “1e”: ${bad}; status: ${status.slice(0, 60)}…`;
+  // A start patch the model does not have is named, not dropped silently.
+  await page.goto(`${url}?model=keycap-convex&start-patch=7`);
+  await waitState(page, 'model-loaded');
+  const patches = await host(page, (el) => el.model.summary.patches);
+  const ps = await page.textContent('#status');
+  check(patches <= 7 && /start patch “7”/.test(ps) && /left at auto/.test(ps), `the missing patch is named: ${ps}`);
+  check(await page.inputValue('#p-start-patch') === '', 'the start patch is auto');
+  return `“0,02” planned as ${h} mm; “1e”: ${bad}; status: ${status.slice(0, 60)}…; ${ps.slice(0, 90)}…`;
 });
 
 test('a file model survives a reload; a link to a file this browser does not keep says so', async (page, url) => {
@@ -1478,6 +1485,86 @@ test('program zero: the triad at the model\'s origin is the program\'s X0 Y0 Z0 
   const px = await host(page, (el) => el.layerPixels('zero'));
   check(px > 30, `the triad is drawn (${px} px)`);
   return `G56; ${blocks.length} blocks at the planned tips (worst ${worst.toExponential(1)} mm); triad ${px} px`;
+});
+
+test('a saved job reopens in a fresh browser to the same plan: the same G-code bytes; a broken job is named', async (page, url) => {
+  await page.goto(`${url}?model=dome&tool-radius=0.8&scallop=0.04&feed-height=1.5&work-offset=56&dialect=fanuc&rotate=90&${SIM}`);
+  await waitState(page, 'model-loaded');
+  const obj = extrudedObj();
+  await page.setInputFiles('#file', { name: 'wave-sheet.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  const job = await downloadText(page, '#save-job');
+  check(job.name === 'wave-sheet.tspath-job.json', `the job's name: ${job.name}`);
+  const saved = JSON.parse(job.bytes.toString('utf8'));
+  check(saved.format === 'tspath-job' && saved.planned === true && saved.model.file === 'wave-sheet.obj', `the job holds the file and says planned: ${JSON.stringify({ ...saved, model: { file: saved.model.file }, parameters: undefined })}`);
+  check(Buffer.from(saved.model.bytes_base64, 'base64').toString('utf8') === obj, 'the job holds the model file, byte for byte');
+  // The CLI's program for the same settings: the job is that job.
+  await writeFile(join(work, 'wave-sheet.obj'), obj);
+  const cli = cliPlan('wave-sheet.obj', { toolRadius: 0.8, scallop: 0.04, dialect: 'fanuc', extra: ['--rotate', '90', '--feed-height', '1.5', '--work-offset', 'G56'] });
+  check(g === cli.gcode, `the page's program is the CLI's (${g.length} vs ${cli.gcode.length} bytes)`);
+  // Another browser profile (nothing kept), opened on the default sample: the job file
+  // brings back the model, every parameter and the plan.
+  const other = await page.context().browser().newContext({ acceptDownloads: true, viewport: { width: 1280, height: 860 } });
+  const p2 = await other.newPage();
+  await p2.goto(url);
+  await p2.waitForSelector(`${HOST}[data-state="model-loaded"]`, { state: 'attached', timeout: 30000 });
+  await p2.setInputFiles('#file', { name: job.name, mimeType: 'application/json', buffer: job.bytes });
+  await waitPlans(p2, 1);
+  await p2.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g2 = (await downloadText(p2, '#download-gcode')).bytes.toString('utf8');
+  check(g2 === g, `the reopened job's program is the same, byte for byte (${g2.length} vs ${g.length} bytes)`);
+  const shown = await p2.evaluate(() => ['tool-radius', 'scallop', 'feed-height', 'work-offset', 'dialect', 'rotate'].map((k) => document.querySelector('tspath-planner').shadowRoot.getElementById(`p-${k}`).value));
+  check(JSON.stringify(shown) === JSON.stringify(['0.8', '0.04', '1.5', '56', 'fanuc', '90']), `the parameters shown are the job's: ${shown}`);
+  check(new URL(p2.url()).searchParams.get('model') === 'file:wave-sheet.obj', `the URL names the file: ${p2.url()}`);
+  // A job whose model was cut out is named, and the plan shown stays.
+  const broken = JSON.stringify({ ...saved, model: {} });
+  await p2.setInputFiles('#file', { name: 'broken.tspath-job.json', mimeType: 'application/json', buffer: Buffer.from(broken) });
+  await p2.waitForFunction((h) => /broken\.tspath-job\.json/.test(document.querySelector(h).shadowRoot.getElementById('status').textContent), HOST);
+  const st = await p2.locator(`${HOST} >> #status`).textContent();
+  check(/names no model/.test(st), `the broken job is named with why: ${st}`);
+  check(await p2.evaluate((h) => document.querySelector(h).dataset.state, HOST) === 'planned', 'the plan shown stays');
+  await other.close();
+  return `job ${job.bytes.length} bytes; reopened in a fresh profile: G-code ${g2.length} bytes, equal; broken job: “${st.slice(0, 60)}…”`;
+});
+
+test('races: the tool and the listing follow the slider moved while the program is written; an error shown during the simulation stays', async (page, url) => {
+  await page.goto(`${url}?model=dome&scallop=0.05&${SIM}`);
+  await waitState(page, 'model-loaded');
+  await page.uncheck('#auto');
+  // The worker's answers to `post` and `verify` held back 600 ms, as on a slow machine.
+  await host(page, (el) => {
+    const call = el.client.call.bind(el.client);
+    el.client.call = async (name, args, progress) => {
+      if (name === 'post' || name === 'verify') await new Promise((res) => setTimeout(res, 600));
+      return call(name, args, progress);
+    };
+  });
+  await page.click('#plan');
+  await page.waitForSelector(`${HOST}[data-state="planned"]`, { state: 'attached' });
+  // Moved while the program is still being written.
+  const to = await host(page, (el) => {
+    const s = el.shadowRoot.getElementById('scrub');
+    s.value = String(Math.floor(Number(s.max) / 2));
+    s.dispatchEvent(new Event('input'));
+    return Number(s.value);
+  });
+  await waitPlans(page, 1);
+  const after = await host(page, (el) => ({ move: Number(el.dataset.move), slider: Number(el.shadowRoot.getElementById('scrub').value), line: Number(el.shadowRoot.getElementById('listing').dataset.line), lineOf: el.plan.gcode.lines[Number(el.dataset.move)] }));
+  check(after.move === to && after.slider === to, `the tool stays where the slider was moved (${JSON.stringify(after)}, moved to ${to})`);
+  check(after.line === after.lineOf && after.line > 1, `the listing shows the block of that move: ${JSON.stringify(after)}`);
+  // A wrong value typed during the simulation: its error stays when the simulation ends.
+  await page.waitForFunction((h) => document.querySelector(h).dataset.verify === 'running', HOST);
+  await setParam(page, 'scallop', '-1');
+  const err = await page.locator(`${HOST} >> #status`).textContent();
+  await waitVerified(page);
+  const st = await page.locator(`${HOST} >> #status`).textContent();
+  const tone = await page.evaluate((h) => document.querySelector(h).shadowRoot.getElementById('status').className, HOST);
+  check(st === err && /error/.test(tone), `the error stays after the simulation: “${st}” (was “${err}”)`);
+  return `slider at move ${to}: tool there, listing line ${after.line}; “${st.slice(0, 60)}…” stays`;
 });
 
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
