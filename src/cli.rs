@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::machine::{self, Dialect, JobInfo, Units};
-use crate::model::setup::{ImportSetup, LengthUnit, Up};
+use crate::model::setup::{ImportSetup, LengthUnit, ProgramZero, Up};
 use crate::model::{samples, Model};
 use crate::plan::{self, PlanOptions, Strategy};
 use crate::verify::{self, CutterPath, VerifyOptions};
@@ -44,7 +44,12 @@ MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample. Ever
 that reads a MODEL places it with [--model-units mm|cm|m|inch] (the unit of a file that
 does not say its own, OBJ; default mm) [--scale F] [--up z|y] (y: the file's +Y becomes +Z,
 as modelling tools write) [--rotate 0|90|180|270] (about +Z, counter-clockwise from above)
-[--on-table] (lowest point at Z 0); `info` shows the placement and the millimetre box.
+[--on-table] (lowest point at Z 0) [--stock-side MM] [--stock-top MM] (stock beyond the
+part's box in X/Y and above it; its bottom is the part's lowest point) [--zero WHERE]
+(the program's X0 Y0 Z0: model (default, the model's origin), stock-top-centre,
+stock-top-corner, stock-bottom-centre, stock-bottom-corner (front-left: least X, Y), or a
+point x,y,z in mm of the placed model); `info` shows the placement, the millimetre box
+and the stock.
 --clearance is the safe plane's height above the model (default 5 mm); the tool rapids
 down to --feed-height above each cut (default 2 mm, along its way down) and goes on at
 --plunge-feed (default 300 mm/min).
@@ -263,7 +268,15 @@ fn export(args: &[String]) -> Result<String> {
 }
 
 /// The model set-up flags every command that reads a model takes.
-const SETUP_FLAGS: &[&str] = &["--model-units", "--scale", "--up", "--rotate"];
+const SETUP_FLAGS: &[&str] = &[
+    "--model-units",
+    "--scale",
+    "--up",
+    "--rotate",
+    "--stock-side",
+    "--stock-top",
+    "--zero",
+];
 const SETUP_SWITCHES: &[&str] = &["--on-table"];
 
 /// The model set-up the flags ask for.
@@ -291,6 +304,15 @@ fn import_setup(a: &Args) -> Result<ImportSetup> {
         s.rotate_deg = turn as u32;
     }
     s.on_table = a.has("--on-table");
+    if let Some(v) = a.number("--stock-side")? {
+        s.stock_side_mm = v;
+    }
+    if let Some(v) = a.number("--stock-top")? {
+        s.stock_top_mm = v;
+    }
+    if let Some(z) = a.value("--zero") {
+        s.zero = ProgramZero::parse(z)?;
+    }
     s.validate()?;
     Ok(s)
 }
@@ -311,6 +333,9 @@ const PLAN_FLAGS: &[&str] = &[
     "--scale",
     "--up",
     "--rotate",
+    "--stock-side",
+    "--stock-top",
+    "--zero",
     "--slice-angle",
     "--tool-radius",
     "--scallop",
@@ -465,10 +490,7 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
     let gcode = machine::post(
         &planned.toolpath,
         &opts,
-        &JobInfo {
-            model: m.name.clone(),
-            strategy: planned.strategy.into(),
-        },
+        &JobInfo::for_model(&m, planned.strategy),
         &mach,
         dialect,
         units,
@@ -568,6 +590,9 @@ fn verify_cmd(args: &[String]) -> Result<String> {
             "--scale",
             "--up",
             "--rotate",
+            "--stock-side",
+            "--stock-top",
+            "--zero",
         ],
         SETUP_SWITCHES,
     )?;

@@ -100,6 +100,7 @@ fn same_input_same_gcode() {
     let job = tspath::machine::JobInfo {
         model: "dome".into(),
         strategy: "isoparametric".into(),
+        program_zero: "the model's origin".into(),
     };
     let a = isoparametric::plan_zigzag(&m, &opts, &mut |_| true).unwrap();
     let b = isoparametric::plan_zigzag(&m, &opts, &mut |_| true).unwrap();

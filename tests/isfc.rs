@@ -333,6 +333,7 @@ fn same_input_same_program() {
     let job = JobInfo {
         model: "plate-hole".into(),
         strategy: "isfc".into(),
+        program_zero: "the model's origin".into(),
     };
     let program = || {
         let p = plan::plan(&m, &o, &mut |_| true).unwrap();

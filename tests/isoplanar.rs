@@ -276,6 +276,7 @@ fn the_same_input_gives_the_same_program() {
     let job = JobInfo {
         model: "keycap-convex".into(),
         strategy: "isoplanar".into(),
+        program_zero: "the model's origin".into(),
     };
     let program = || {
         let p = plan::plan(&m, &o, &mut |_| true).unwrap();

@@ -58,6 +58,7 @@ fn program_poses(
     let job = JobInfo {
         model: "test".into(),
         strategy: planned.strategy.into(),
+        program_zero: "the model's origin".into(),
     };
     let text = machine::post(&planned.toolpath, opts, &job, &mach, dialect, Units::Mm).unwrap();
     let r = opts.tool_radius_mm;

@@ -7,7 +7,7 @@ mod support;
 use support::extruded_obj;
 use tspath::geom::Point3;
 use tspath::io;
-use tspath::model::setup::{ImportSetup, LengthUnit, Up};
+use tspath::model::setup::{ImportSetup, LengthUnit, ProgramZero, Up};
 
 /// A wavy sheet as a modelling tool writes it, Y up: profile in x–y, extruded along z.
 fn y_up_cage() -> String {
@@ -172,4 +172,143 @@ fn the_cli_places_models_as_asked() {
         assert!((ext(b) - 2.0 * ext(a)).abs() < 1e-9 * ext(b).max(1.0));
     }
     assert!(b["min"][2].as_f64().unwrap().abs() < 1e-9);
+}
+
+/// Stock and program zero (issue 18): the stock is the part's box grown by the side and top
+/// stock (bottom flush), and the model moves so that the chosen point of it is the origin:
+/// every surface point moves by exactly that shift, and the program says where its zero is.
+#[test]
+fn the_program_zero_goes_where_the_stock_says() {
+    let keycap = tspath::model::samples::sample_json("keycap-convex").unwrap();
+    let plain = io::load(keycap.as_bytes(), "keycap").unwrap();
+    let part = plain.surface.bbox();
+    let size = part.diagonal();
+    let (side, top) = (2.5, 1.25);
+    let c = |k: usize| 0.5 * (part.min[k] + part.max[k]);
+    // Each zero, and where it is in the unplaced model's coordinates (closed form).
+    let cases = [
+        (ProgramZero::Model, [0.0, 0.0, 0.0]),
+        (ProgramZero::StockTopCentre, [c(0), c(1), part.max[2] + top]),
+        (
+            ProgramZero::StockTopCorner,
+            [part.min[0] - side, part.min[1] - side, part.max[2] + top],
+        ),
+        (ProgramZero::StockBottomCentre, [c(0), c(1), part.min[2]]),
+        (
+            ProgramZero::StockBottomCorner,
+            [part.min[0] - side, part.min[1] - side, part.min[2]],
+        ),
+        (ProgramZero::At([1.5, -2.0, 3.25]), [1.5, -2.0, 3.25]),
+    ];
+    let faces = plain.surface.faces().len();
+    for (zero, at) in cases {
+        let setup = ImportSetup {
+            stock_side_mm: side,
+            stock_top_mm: top,
+            zero,
+            ..ImportSetup::default()
+        };
+        let m = io::load_with(keycap.as_bytes(), "keycap", &setup).unwrap();
+        let shift = Point3::from(at).coords;
+        let mut worst: f64 = 0.0;
+        for (f, u, v) in face_samples(5, faces) {
+            let want = plain.surface.subs(f, u, v) - shift;
+            worst = worst.max((m.surface.subs(f, u, v) - want).norm());
+        }
+        assert!(worst <= 1e-12 * size, "{zero:?}: {worst:e} mm");
+        // The stock: the part's box grown by the stock, moved with the part.
+        let want_lo = [part.min[0] - side, part.min[1] - side, part.min[2]];
+        let want_hi = [part.max[0] + side, part.max[1] + side, part.max[2] + top];
+        for k in 0..3 {
+            assert!((m.stock.min[k] - (want_lo[k] - at[k])).abs() <= 1e-9 * size);
+            assert!((m.stock.max[k] - (want_hi[k] - at[k])).abs() <= 1e-9 * size);
+        }
+        assert_eq!(m.program_zero, zero.describe());
+        assert_eq!(m.summary().stock_mm, m.stock);
+    }
+    // On the table and at the stock's top corner: the stock's top is Z 0, its corner X0 Y0.
+    let args = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    let info: serde_json::Value = serde_json::from_str(
+        &tspath::cli::run(&args(&[
+            "info",
+            "keycap-convex",
+            "--on-table",
+            "--stock-side",
+            "2.5",
+            "--stock-top",
+            "1.25",
+            "--zero",
+            "stock-top-corner",
+        ]))
+        .unwrap(),
+    )
+    .unwrap();
+    let v = |b: &str, e: &str, k: usize| info[b][e][k].as_f64().unwrap();
+    assert!(v("stock_mm", "min", 0).abs() < 1e-9 && v("stock_mm", "min", 1).abs() < 1e-9);
+    assert!(v("stock_mm", "max", 2).abs() < 1e-9);
+    assert!(
+        (v("bbox_mm", "max", 2) + 1.25).abs() < 1e-9 && (v("bbox_mm", "min", 0) - 2.5).abs() < 1e-9
+    );
+    assert!((v("stock_mm", "min", 2) + (part.max[2] - part.min[2]) + 1.25).abs() < 1e-9);
+    let p = info["placement"].as_str().unwrap();
+    assert!(
+        p.contains("stock 2.5 mm") && p.contains("top front-left"),
+        "{p}"
+    );
+    // The program says where its zero is.
+    let dir = std::env::temp_dir().join(format!("tspath-zero-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("k.nc");
+    let run = tspath::cli::run(&args(&[
+        "plan",
+        "keycap-convex",
+        "--tool-radius",
+        "0.5",
+        "--scallop",
+        "0.05",
+        "--zero",
+        "stock-top-centre",
+        "--stock-top",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]));
+    assert!(run.is_ok(), "{run:?}");
+    let g = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        g.contains("program zero: work offset G54, set at the centre of the stock's top"),
+        "{}",
+        &g[..600.min(g.len())]
+    );
+    // Every block at the cutting feed is below the stock's top (Z 0) by its 1 mm of stock
+    // (the part's top is at Z -1; the approaches at the plunge feed come from above it).
+    let mut feed = 0.0;
+    let mut highest = f64::NEG_INFINITY;
+    for l in g.lines().filter(|l| l.starts_with("G1 ")) {
+        let word = |k: char| {
+            l.split_whitespace()
+                .find(|w| w.starts_with(k))
+                .map(|w| w[1..].parse::<f64>().unwrap())
+        };
+        feed = word('F').unwrap_or(feed);
+        if feed == 1000.0 {
+            highest = highest.max(word('Z').unwrap_or(f64::NEG_INFINITY));
+        }
+    }
+    assert!(
+        highest <= -1.0 + 1e-4 && highest > -1.5,
+        "highest tip at the cutting feed {highest} mm"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    // Bad zeros and stock are named.
+    for (flags, what) in [
+        (vec!["--zero", "top"], "not a program zero"),
+        (vec!["--zero", "1,2"], "x,y,z"),
+        (vec!["--stock-side", "-1"], "0 mm or more"),
+    ] {
+        let mut a = args(&["info", "dome"]);
+        a.extend(args(&flags));
+        let e = tspath::cli::run(&a).unwrap_err().to_string();
+        assert!(e.contains(what), "{flags:?}: {e}");
+    }
 }

@@ -27,6 +27,18 @@ export const KINDS = [
 export const BACKGROUND = 0xeef1f5;
 /** The program-zero triad: X, Y, Z. */
 export const ZERO_TRIAD = [0xd62728, 0x2ca02c, 0x1f5fd6];
+/** The stock block: its edges, and its faces (translucent). */
+export const STOCK = { edge: 0x8a6d3b, face: 0xc8a96e, opacity: 0.12 };
+
+/** The 12 edges of the box `{min, max}` (mm) as line segments: x0 y0 z0 x1 y1 z1 each. */
+export function boxEdges(b) {
+  const c = (i) => [i & 1 ? b.max[0] : b.min[0], i & 2 ? b.max[1] : b.min[1], i & 4 ? b.max[2] : b.min[2]];
+  const out = [];
+  for (let i = 0; i < 8; i++) {
+    for (const bit of [1, 2, 4]) if (!(i & bit)) out.push(...c(i), ...c(i | bit));
+  }
+  return out;
+}
 
 /** Ground of small drawings on the page (the comparison's paths). */
 export const BACKGROUND_LIGHT = 0xf8f9fb;

@@ -18,6 +18,12 @@ export const PARAMS = [
   { key: 'up', field: null, group: 'placement', placement: true, label: 'The file\u2019s up axis', kind: 'choice', choices: [['z', '+Z (machines)'], ['y', '+Y (most modelling tools): turned to +Z']], default: 'z' },
   { key: 'rotate', field: null, group: 'placement', placement: true, label: 'Turn about Z (counter-clockwise from above)', unit: '°', kind: 'choice', choices: [['0', '0°'], ['90', '90°'], ['180', '180°'], ['270', '270°']], default: '0' },
   { key: 'on-table', field: null, group: 'placement', placement: true, label: 'Lowest point on the table (Z 0)', kind: 'flag', default: false },
+  { key: 'stock-side', field: null, group: 'placement', placement: true, label: 'Stock beyond the part, each side (X, Y)', unit: 'mm', kind: 'number', min: 0, max: 10000, step: 0.5, default: 0 },
+  { key: 'stock-top', field: null, group: 'placement', placement: true, label: 'Stock above the part', unit: 'mm', kind: 'number', min: 0, max: 10000, step: 0.5, default: 0 },
+  { key: 'zero', field: null, group: 'placement', placement: true, label: 'Program zero (X0 Y0 Z0)', kind: 'choice', choices: [['model', 'the model\u2019s origin'], ['stock-top-centre', 'stock top, centre'], ['stock-top-corner', 'stock top, front-left corner'], ['stock-bottom-centre', 'stock bottom, centre'], ['stock-bottom-corner', 'stock bottom, front-left corner'], ['point', 'a point typed below']], default: 'model' },
+  { key: 'zero-x', field: null, group: 'placement', placement: true, zeroPoint: true, label: 'Program zero at X (model as placed)', unit: 'mm', kind: 'number', min: -100000, max: 100000, step: 1, default: 0 },
+  { key: 'zero-y', field: null, group: 'placement', placement: true, zeroPoint: true, label: 'Program zero at Y', unit: 'mm', kind: 'number', min: -100000, max: 100000, step: 1, default: 0 },
+  { key: 'zero-z', field: null, group: 'placement', placement: true, zeroPoint: true, label: 'Program zero at Z', unit: 'mm', kind: 'number', min: -100000, max: 100000, step: 1, default: 0 },
   // Strategy
   { key: 'strategy', field: 'strategy', group: 'strategy', label: 'How the surface is cut', kind: 'choice', choices: [['isoparametric', 'Patch by patch (isoparametric)'], ['isfc', 'One continuous pass (space-filling curve)'], ['watershed', 'Feature regions in rectangles (watershed)'], ['multi-rectangle', 'Rectangles, one direction (multi-rectangle)'], ['isoplanar', 'Parallel planes (iso-planar, deformed CL surface)']], default: 'isoparametric' },
   { key: 'isfc-plain', field: 'isfc_plain', group: 'strategy', label: 'Plain curve: the paper\u2019s baseline, without the parity repair and the corner compensation', kind: 'flag', default: false, isfcOnly: true },
@@ -183,7 +189,13 @@ export function placement(values) {
     up: values.up || 'z',
     rotate_deg: Number(values.rotate || 0),
     on_table: !!values['on-table'],
+    stock_side_mm: Number(values['stock-side'] || 0),
+    stock_top_mm: Number(values['stock-top'] || 0),
+    zero: values.zero === 'point'
+      ? { at: ['zero-x', 'zero-y', 'zero-z'].map((k) => Number(values[k] || 0)) }
+      : values.zero || 'model',
   };
-  const identity = !s.model_units && s.scale === 1 && s.up === 'z' && s.rotate_deg === 0 && !s.on_table;
+  const identity = !s.model_units && s.scale === 1 && s.up === 'z' && s.rotate_deg === 0 && !s.on_table
+    && !s.stock_side_mm && !s.stock_top_mm && s.zero === 'model';
   return identity ? null : s;
 }

@@ -208,7 +208,7 @@ const TEMPLATE = `
       <label class="inline"><input type="checkbox" id="layer-tool" checked> Tool</label>
       <label class="inline"><input type="checkbox" id="layer-cage"> Control mesh</label>
       <label class="inline"><input type="checkbox" id="layer-eps" checked> Extraordinary points</label>
-      <label class="inline" title="The model's origin: the program's X0 Y0 Z0 in the work offset chosen (X red, Y green, Z blue)"><input type="checkbox" id="layer-zero" checked> Program zero</label>
+      <label class="inline" title="The program's X0 Y0 Z0 in the work offset chosen (X red, Y green, Z blue), and the stock block (brown)"><input type="checkbox" id="layer-zero" checked> Program zero and stock</label>
       <button id="fit" type="button">Fit view</button>
     </div>
     <div class="scrub">
@@ -813,7 +813,10 @@ export class TspathPlanner extends HTMLElement {
     this.model = { ...m, sample, file: source.sample ? null : label, pub };
     // A file of the user's is kept for the next visit (the URL names it).
     if (!source.sample && !pub && source.bytes) {
-      saveLastFile(label, source.bytes).catch((e) => console.warn('could not keep the file:', e));
+      // `data-kept` names it once stored (a reload before then opens the first sample).
+      saveLastFile(label, source.bytes)
+        .then(() => { this.dataset.kept = label; })
+        .catch((e) => console.warn('could not keep the file:', e));
     }
     this.#clearPlan();
     // A comparison is of the model it was made on.
@@ -852,6 +855,8 @@ export class TspathPlanner extends HTMLElement {
       ['Format', s.format + (s.units_read && s.units_read !== 'mm' ? ` (${s.units_read})` : '')],
       ['Size (mm)', size.map((v) => v.toFixed(v < 10 ? 2 : 1)).join(' × ')],
       ['Placement', s.placement],
+      ['Stock', `${s.stock_mm.max.map((v, k) => (v - s.stock_mm.min[k]).toFixed(2)).join(' × ')} mm`],
+      ['Program zero', s.program_zero],
       ['Faces', int(s.faces)],
       ['Control points', int(s.control_points)],
       ['Patches', int(s.patches)],
@@ -1013,6 +1018,11 @@ export class TspathPlanner extends HTMLElement {
         el.title = strategy === name ? '' : `Only for ${what}`;
       }
     }
+    const typed = this.$('p-zero').value === 'point';
+    for (const p of PARAMS.filter((q) => q.zeroPoint)) {
+      this.$(`p-${p.key}`).disabled = !typed;
+      this.$(`p-${p.key}`).title = typed ? '' : 'Choose “a point typed below” as the program zero';
+    }
     const m = this.machineRotaries?.[this.$('p-machine').value];
     this.$('p-machine').title = m ? m.description : '';
   }
@@ -1044,6 +1054,7 @@ export class TspathPlanner extends HTMLElement {
     }
     if (byKey[key]?.placement) {
       // The model is read again, placed anew (the plan, made on the old placement, goes).
+      if (key === 'zero') this.#updateDependentControls();
       this.#validateAll();
       this.#syncUrl();
       const { errors } = validate(this.#raw(), { patches: 1, fiveAxis: this.#fiveAxis });

@@ -6,7 +6,7 @@
 // control mesh, the path by kind and the tool as its outline. Same interface as View3D. Z is
 // up; mm.
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, ZERO_TRIAD, heatColour, hexCss, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, STOCK, ZERO_TRIAD, boxEdges, heatColour, hexCss, pathColour,
 } from './colours.js';
 
 const rgb = (c) => [c >> 16 & 255, c >> 8 & 255, c & 255];
@@ -331,6 +331,8 @@ export class View2D {
 
   /** Program zero: the axis triad at the model's origin (see View3D). */
   #drawZero(proj) {
+    const stock = this.model.summary?.stock_mm;
+    if (stock) this.#segments(proj, boxEdges(stock), () => true, STOCK.edge, 1, 0.8);
     const len = 0.4 * this.radius;
     const axes = [[len, 0, 0], [0, len, 0], [0, 0, len]];
     axes.forEach((a, k) => this.#segments(proj, [0, 0, 0, ...a], () => true, ZERO_TRIAD[k], 2, 1));

@@ -7,7 +7,7 @@
 import * as THREE from './vendor/three.module.js';
 import { OrbitControls } from './vendor/OrbitControls.js';
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, ZERO_TRIAD, heatColour, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, STOCK, ZERO_TRIAD, boxEdges, heatColour, pathColour,
 } from './colours.js';
 
 const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
@@ -134,6 +134,19 @@ export class View3D {
       const triad = new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false }));
       triad.renderOrder = 10;
       this.groups.zero.add(triad);
+    }
+    // The stock block around the part (same layer): translucent faces, solid edges.
+    const stock = m.summary?.stock_mm;
+    if (stock) {
+      const d = [0, 1, 2].map((k) => Math.max(stock.max[k] - stock.min[k], 1e-6));
+      const box = new THREE.Mesh(
+        new THREE.BoxGeometry(d[0], d[1], d[2]),
+        new THREE.MeshBasicMaterial({ color: STOCK.face, transparent: true, opacity: STOCK.opacity, depthWrite: false, side: THREE.DoubleSide }),
+      );
+      box.position.set(...[0, 1, 2].map((k) => 0.5 * (stock.min[k] + stock.max[k])));
+      const eg = new THREE.BufferGeometry();
+      eg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(boxEdges(stock)), 3));
+      this.groups.zero.add(box, new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ color: STOCK.edge })));
     }
     if (m.cage.length) {
       const cg = new THREE.BufferGeometry();

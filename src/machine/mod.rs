@@ -30,6 +30,19 @@ use crate::plan::{PlanOptions, Toolpath};
 pub struct JobInfo {
     pub model: String,
     pub strategy: String,
+    /// Where the program's zero is on the part or stock, in words ("the model's origin").
+    pub program_zero: String,
+}
+
+impl JobInfo {
+    /// The header of a program for `model` planned with `strategy`.
+    pub fn for_model(model: &crate::model::Model, strategy: &str) -> JobInfo {
+        JobInfo {
+            model: model.name.clone(),
+            strategy: strategy.into(),
+            program_zero: model.program_zero.clone(),
+        }
+    }
 }
 
 /// The program for `path` on `machine` in `dialect` and `units`. Deterministic: the same

@@ -558,7 +558,8 @@ pub fn post_program(
     // The work offset: the program's zero is where the operator set it.
     let offset = opts.work_offset;
     o.comment(&format!(
-        "program zero: work offset G{offset}, set at the model's origin"
+        "program zero: work offset G{offset}, set at {}",
+        job.program_zero
     ));
     match syntax {
         Syntax::Iso => {

@@ -24,6 +24,11 @@ pub struct Model {
     /// How the model was placed ([`setup::ImportSetup::describe`]): "as modelled" unless
     /// set up.
     pub placement: String,
+    /// The stock block (mm, in the model's coordinates, after placement): the part's box
+    /// unless set up with stock beyond it.
+    pub stock: Aabb,
+    /// Where the program's zero is ([`setup::ProgramZero::describe`]).
+    pub program_zero: String,
     pub mesh: TMesh,
     pub surface: Surface,
     pub layout: PatchLayout,
@@ -60,6 +65,10 @@ pub struct ModelSummary {
     /// How the model was placed: "as modelled", or the unit, scale, up axis, turn and
     /// table placement applied.
     pub placement: String,
+    /// The stock block (mm): the part's box unless set up with stock beyond it.
+    pub stock_mm: Aabb,
+    /// Where the program's zero (X0 Y0 Z0 of the work offset) is, in words.
+    pub program_zero: String,
     pub vertices: usize,
     pub faces: usize,
     pub control_points: usize,
@@ -80,6 +89,8 @@ impl Model {
         let layout = PatchLayout::build(&mesh, &surface);
         Ok(Model {
             layout,
+            stock: surface.bbox(),
+            program_zero: setup::ProgramZero::Model.describe(),
             name: name.to_string(),
             format: format.to_string(),
             units_read: units_read.to_string(),
@@ -110,14 +121,26 @@ impl Model {
             mesh
         };
         let mut m = Model::try_new(name, format, units_read, mesh)?;
-        if setup.on_table {
-            let z = m.surface.bbox().min[2];
-            if z != 0.0 {
-                let mesh = setup::shifted(&m.mesh, crate::geom::Vector3::new(0.0, 0.0, -z))?;
-                m = Model::try_new(name, format, units_read, mesh)?;
-            }
+        // On the table, then the zero: one shift (a translation moves the box with it).
+        let part = m.surface.bbox();
+        let table = if setup.on_table { -part.min[2] } else { 0.0 };
+        let on_table = Aabb {
+            min: [part.min[0], part.min[1], part.min[2] + table],
+            max: [part.max[0], part.max[1], part.max[2] + table],
+        };
+        let stock = setup::stock_box(&on_table, setup);
+        let zero = setup.zero.point(&stock);
+        let shift = crate::geom::Vector3::new(-zero.x, -zero.y, table - zero.z);
+        if shift != crate::geom::Vector3::zeros() {
+            let mesh = setup::shifted(&m.mesh, shift)?;
+            m = Model::try_new(name, format, units_read, mesh)?;
         }
+        m.stock = Aabb {
+            min: [0, 1, 2].map(|k| stock.min[k] - zero[k]),
+            max: [0, 1, 2].map(|k| stock.max[k] - zero[k]),
+        };
         m.placement = setup.describe(declared_mm.is_some());
+        m.program_zero = setup.zero.describe();
         Ok(m)
     }
 
@@ -128,6 +151,8 @@ impl Model {
             format: self.format.clone(),
             units_read: self.units_read.clone(),
             placement: self.placement.clone(),
+            stock: self.stock,
+            program_zero: self.program_zero.clone(),
             mesh: self.mesh.clone(),
             surface: self.surface.clone(),
             layout,
@@ -251,6 +276,8 @@ impl Model {
             format: self.format.clone(),
             units_read: self.units_read.clone(),
             placement: self.placement.clone(),
+            stock_mm: self.stock,
+            program_zero: self.program_zero.clone(),
             vertices: nv,
             faces: self.mesh.faces().len(),
             control_points: nv,

@@ -295,10 +295,7 @@ impl WasmModel {
     ) -> WasmPlan {
         let rest_rects = planned.rest_rects(&self.model);
         let (rest_positions, rest_why) = planned.rest_triangles(&self.model);
-        let job = JobInfo {
-            model: self.model.name.clone(),
-            strategy: planned.strategy.into(),
-        };
+        let job = JobInfo::for_model(&self.model, planned.strategy);
         WasmPlan {
             isfc_layer: planned.isfc_layer,
             watershed_layer: planned.watershed_layer,

@@ -1449,6 +1449,8 @@ test('a file model survives a reload; a link to a file this browser does not kee
   await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
   const before = await host(page, (el) => el.model.summary);
   check(new URL(page.url()).searchParams.get('model') === 'file:wave-sheet.obj', `the URL names the file: ${page.url()}`);
+  // Kept in the browser (stored after the model is shown), then reloaded.
+  await page.waitForSelector(`${HOST}[data-kept="wave-sheet.obj"]`, { state: 'attached' });
   await page.reload();
   await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded', HOST, { timeout: 30000 });
   const after = await host(page, (el) => el.model.summary);
@@ -1565,6 +1567,42 @@ test('races: the tool and the listing follow the slider moved while the program 
   const tone = await page.evaluate((h) => document.querySelector(h).shadowRoot.getElementById('status').className, HOST);
   check(st === err && /error/.test(tone), `the error stays after the simulation: “${st}” (was “${err}”)`);
   return `slider at move ${to}: tool there, listing line ${after.line}; “${st.slice(0, 60)}…” stays`;
+});
+
+test('stock and program zero: at the stock\'s top corner and at a typed point, as the CLI\'s --stock-side --stock-top --zero; the stock drawn', async (page, url) => {
+  await page.goto(`${url}?model=keycap-convex&tool-radius=0.5&scallop=0.05&on-table=1&stock-side=2&stock-top=1&zero=stock-top-corner`);
+  await waitState(page, 'model-loaded');
+  const flags = ['--on-table', '--stock-side', '2', '--stock-top', '1', '--zero', 'stock-top-corner'];
+  const info = JSON.parse(runCli(['info', 'keycap-convex', ...flags]).stdout);
+  const mine = await host(page, (el) => el.model.summary);
+  check(JSON.stringify(mine.stock_mm) === JSON.stringify(info.stock_mm) && JSON.stringify(mine.bbox_mm) === JSON.stringify(info.bbox_mm), `stock and box as the CLI's: ${JSON.stringify(mine.stock_mm)} vs ${JSON.stringify(info.stock_mm)}`);
+  check(Math.abs(mine.stock_mm.min[0]) < 1e-9 && Math.abs(mine.stock_mm.min[1]) < 1e-9 && Math.abs(mine.stock_mm.max[2]) < 1e-9, `the stock's top front-left corner is X0 Y0 Z0: ${JSON.stringify(mine.stock_mm)}`);
+  const shown = (await page.textContent('#summary-program-zero')).trim();
+  check(/top front-left corner/.test(shown), `the summary says where zero is: ${shown}`);
+  const stockRow = (await page.textContent('#summary-stock')).trim();
+  check(/× .* mm$/.test(stockRow), `the stock's size: ${stockRow}`);
+  // The stock is drawn with the program zero: the layer shows more than the triad alone.
+  const withStock = await host(page, (el) => el.layerPixels('zero'));
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  await page.waitForSelector('#download-gcode:not([disabled])', { state: 'attached' });
+  const g = (await downloadText(page, '#download-gcode')).bytes.toString('utf8');
+  const cli = cliPlan('keycap-convex', { toolRadius: 0.5, scallop: 0.05, extra: flags });
+  check(g === cli.gcode, `the program is the CLI's (${g.length} vs ${cli.gcode.length} bytes)`);
+  check(/program zero: work offset G54, set at the stock's top front-left corner/.test(g), 'the program says where its zero is');
+  // A typed point.
+  await setParam(page, 'zero', 'point');
+  await page.waitForFunction((h) => document.querySelector(h).shadowRoot.getElementById('p-zero-x').disabled === false, HOST);
+  await setParam(page, 'zero-x', '1,5');
+  await setParam(page, 'zero-y', '-2');
+  await setParam(page, 'zero-z', '3');
+  await page.waitForFunction((h) => /\(1\.5, -2, 3\)/.test(document.querySelector(h).model?.summary?.program_zero || ''), HOST);
+  const typed = await host(page, (el) => el.model.summary);
+  const tinfo = JSON.parse(runCli(['info', 'keycap-convex', '--on-table', '--stock-side', '2', '--stock-top', '1', '--zero', '1.5,-2,3']).stdout);
+  check(JSON.stringify(typed.bbox_mm) === JSON.stringify(tinfo.bbox_mm), `typed zero: the box is the CLI's ${JSON.stringify(typed.bbox_mm)}`);
+  check(new URL(page.url()).searchParams.get('zero') === 'point' && ['1.5', '1,5'].includes(new URL(page.url()).searchParams.get('zero-x')), `the URL keeps it: ${page.url()}`);
+  await page.screenshot({ path: join(shots, 'stock-and-zero.png') });
+  return `stock ${stockRow}; zero “${shown}”; G-code = CLI (${g.length} bytes); layer ${withStock} px; typed (1.5, -2, 3) as the CLI's`;
 });
 
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {

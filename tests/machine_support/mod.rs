@@ -38,6 +38,7 @@ pub fn job(model: &str) -> JobInfo {
     JobInfo {
         model: model.into(),
         strategy: "isoparametric".into(),
+        program_zero: "the model's origin".into(),
     }
 }
 
