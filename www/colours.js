@@ -30,6 +30,37 @@ export const ZERO_TRIAD = [0xd62728, 0x2ca02c, 0x1f5fd6];
 /** The stock block: its edges, and its faces (translucent). */
 export const STOCK = { edge: 0x8a6d3b, face: 0xc8a96e, opacity: 0.12 };
 
+/** The table grid under the part. */
+export const GRID = { line: 0xb9c0ca };
+
+/** Standard views: the direction from the model towards the viewer (Z up). Top and bottom
+ * lean a hair towards -Y so that +Y is up on the screen and the camera's up stays defined. */
+export const VIEWS = {
+  top: [0, -1e-4, 1],
+  front: [0, -1, 0],
+  side: [1, 0, 0],
+  iso: [-0.6, -1, 1.1],
+};
+
+/** A grid on the plane Z = `box.min[2]` covering `box` (mm) with a margin, at a round
+ * spacing (1, 2 or 5 × 10^k mm, about a tenth of the larger side): `{lines, spacing}` with
+ * `lines` as x0 y0 z0 x1 y1 z1 per line; null for no box. */
+export function tableGrid(box) {
+  if (!box) return null;
+  const side = Math.max(box.max[0] - box.min[0], box.max[1] - box.min[1], 1e-6);
+  const raw = side / 10;
+  const p = 10 ** Math.floor(Math.log10(raw));
+  const spacing = [1, 2, 5, 10].map((k) => k * p).find((s) => s >= raw);
+  const lo = [0, 1].map((k) => Math.floor(box.min[k] / spacing - 1) * spacing);
+  const hi = [0, 1].map((k) => Math.ceil(box.max[k] / spacing + 1) * spacing);
+  const z = box.min[2];
+  const lines = [];
+  const n = [0, 1].map((k) => Math.round((hi[k] - lo[k]) / spacing));
+  for (let i = 0; i <= n[0]; i++) lines.push(lo[0] + i * spacing, lo[1], z, lo[0] + i * spacing, hi[1], z);
+  for (let j = 0; j <= n[1]; j++) lines.push(lo[0], lo[1] + j * spacing, z, hi[0], lo[1] + j * spacing, z);
+  return { lines, spacing };
+}
+
 /** The 12 edges of the box `{min, max}` (mm) as line segments: x0 y0 z0 x1 y1 z1 each. */
 export function boxEdges(b) {
   const c = (i) => [i & 1 ? b.max[0] : b.min[0], i & 2 ? b.max[1] : b.min[1], i & 4 ? b.max[2] : b.min[2]];

@@ -43,16 +43,20 @@ export function define(term) {
   return hit ? hit[1] : null;
 }
 
-/** Marks glossary terms in `el`, each term once (its first place): a focusable span whose
- * title and accessible description are the definition, shown on hover and on focus.
+/** Marks glossary terms in `el` (only inside elements matching `within`, if given), each
+ * term once (its first place): a focusable span whose title and accessible description are
+ * the definition, shown on hover and on focus.
  * Idempotent (marked terms are skipped). */
-export function markTerms(el) {
+export function markTerms(el, within = null) {
   const done = new Set([...el.querySelectorAll('.term')].map((t) => t.dataset.definition));
   const doc = el.ownerDocument;
   const walker = doc.createTreeWalker(el, 4 /* NodeFilter.SHOW_TEXT */);
   const nodes = [];
   for (let n = walker.nextNode(); n; n = walker.nextNode()) {
-    if (!n.parentElement?.closest('.term, option, select, button, input, textarea, summary, a')) nodes.push(n);
+    const parent = n.parentElement;
+    if (!parent || parent.closest('.term, option, select, button, input, textarea, summary, a')) continue;
+    if (within && !parent.closest(within)) continue;
+    nodes.push(n);
   }
   for (const n of nodes) {
     const m = PATTERN.exec(n.data);

@@ -13,11 +13,12 @@
 // plan's report says (`planned`, or `planned_with_problems` when it leaves something undone);
 // `data-verify` whether the cutting simulation is running, done or failed; `data-stale`
 // that the parameters no longer match the plan shown (its downloads are off).
+import { GLOSSARY, markTerms } from './glossary.js';
 import { JOB_SUFFIX, isJob, readJob, writeJob } from './job.js';
 import { CancelledError, EngineClient } from './client.js';
 import { loadLastFile, saveLastFile } from './storage.js';
 import {
-  BACKGROUND_LIGHT, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour,
+  BACKGROUND_LIGHT, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, heatColour, hexCss, pathColour, tableGrid,
 } from './colours.js';
 import { area, bytes, deg, int, minutes, mm, mmSig, ms, pct, share } from './format.js';
 import { GROUPS, PARAMS, byKey, flagOn, placement, planOptions, validate } from './params.js';
@@ -191,6 +192,8 @@ const TEMPLATE = `
       <canvas id="view" tabindex="0"
         aria-label="3D view of the model and the tool path. Drag to orbit, right-drag or shift-drag to pan, wheel to zoom; arrow keys orbit, shift+arrows pan, + and - zoom, F fits"></canvas>
       <div id="drop-hint" class="drop-hint" hidden>Drop a .tsm, .obj or .json model to open it</div>
+    </div>
+    <div class="view-legends">
       <div id="heat-legend" class="heat-legend" hidden aria-label="Heat map colours"></div>
       <div id="rest-legend" class="rest-legend" hidden aria-label="Rest area colours"></div>
       <div id="isfc-legend" class="overlay-legend" hidden aria-label="Cells and tree colours"></div>
@@ -209,7 +212,15 @@ const TEMPLATE = `
       <label class="inline"><input type="checkbox" id="layer-cage"> Control mesh</label>
       <label class="inline"><input type="checkbox" id="layer-eps" checked> Extraordinary points</label>
       <label class="inline" title="The program's X0 Y0 Z0 in the work offset chosen (X red, Y green, Z blue), and the stock block (brown)"><input type="checkbox" id="layer-zero" checked> Program zero and stock</label>
+      <label class="inline" id="layer-grid-label" title="A grid on the table (the stock's bottom), its spacing in the label"><input type="checkbox" id="layer-grid" checked> <span id="grid-text">Grid</span></label>
+    </div>
+    <div class="views" role="group" aria-label="Camera">
       <button id="fit" type="button">Fit view</button>
+      <button type="button" data-view="top" title="Looking down -Z, X to the right">Top</button>
+      <button type="button" data-view="front" title="Looking along +Y, X to the right, Z up">Front</button>
+      <button type="button" data-view="side" title="Looking along -X, Y to the right, Z up">Side</button>
+      <button type="button" data-view="iso" title="From the front left, above">Iso</button>
+      <label class="inline" title="Parallel projection: true proportions, no perspective"><input type="checkbox" id="ortho"> Orthographic</label>
     </div>
     <div class="scrub">
       <button id="play" type="button" disabled aria-pressed="false">Play</button>
@@ -239,11 +250,13 @@ const TEMPLATE = `
         <h3 id="problems-title">Problems</h3>
         <ul id="problems" class="problems" aria-labelledby="problems-title"></ul>
       </div>
+      <p id="stats-empty" class="placeholder">Plan a tool path: its lengths, retractions, scallop, machining time and any problems appear here.</p>
       <dl id="stats" class="facts"></dl>
       <ul id="notes" class="notes" aria-label="Notes"></ul>
     </section>
     <section class="listing-section">
       <h2 id="listing-title">G-code</h2>
+      <p id="listing-empty" class="placeholder">The program appears here once planned, the block of the tool's position highlighted.</p>
       <ol id="listing" class="listing" aria-labelledby="listing-title" tabindex="0"></ol>
       <h2>Downloads</h2>
       <div class="downloads">
@@ -252,6 +265,10 @@ const TEMPLATE = `
         <button id="download-stl" type="button" disabled>Surface (STL)</button>
       </div>
     </section>
+    <details class="glossary-section">
+      <summary>Glossary</summary>
+      <dl id="glossary" class="glossary"></dl>
+    </details>
   </aside>
 </div>`;
 
@@ -429,6 +446,7 @@ export class TspathPlanner extends HTMLElement {
     const viewReady = this.#createView();
     this.#buildParams();
     this.#bindUi();
+    this.#buildGlossary();
     let info;
     try {
       [info] = await Promise.all([this.client.ready, viewReady]);
@@ -618,7 +636,15 @@ export class TspathPlanner extends HTMLElement {
     $('params').addEventListener('change', (e) => this.#onParamChange(e.target.name));
     $('params').addEventListener('submit', (e) => e.preventDefault());
     $('fit').addEventListener('click', () => this.view && this.view.fit());
-    for (const k of ['path', 'tool', 'cage', 'eps', 'zero']) {
+    for (const b of this.root.querySelectorAll('[data-view]')) {
+      b.addEventListener('click', () => {
+        if (!this.view) return;
+        this.view.fit(b.dataset.view);
+        this.dataset.view = b.dataset.view;
+      });
+    }
+    $('ortho').addEventListener('change', () => this.view && this.view.setOrtho($('ortho').checked));
+    for (const k of ['path', 'tool', 'cage', 'eps', 'zero', 'grid']) {
       $(`layer-${k}`).addEventListener('change', () => this.view.setLayers({ [k]: $(`layer-${k}`).checked }));
     }
     $('layer-rest').addEventListener('change', () => {
@@ -827,6 +853,8 @@ export class TspathPlanner extends HTMLElement {
     this.#showSummary(m.summary, pub);
     const patchNote = this.#fillPatchChoices(m.summary.patches);
     this.view.setModel(m);
+    const grid = tableGrid(m.summary.stock_mm);
+    this.$('grid-text').textContent = grid ? `Grid (${grid.spacing} mm)` : 'Grid';
     this.#showColours();
     this.view.renderNow();
     if (this.dataset.firstDrawMs === undefined) {
@@ -866,6 +894,7 @@ export class TspathPlanner extends HTMLElement {
       ['Smallest concave radius', concave ? mmSig(concave.radius_mm) : 'none (nothing concave)', concave ? concave.radius_mm : ''],
     ];
     this.#facts(this.$('summary'), rows.map(([k, v, raw]) => [k.toLowerCase().replace(/\W+/g, '-'), k, v, raw]));
+    markTerms(this.$('summary'), 'dt');
     if (pub) {
       // Where the file comes from and under which licence, linked (the licence is served
       // beside the file).
@@ -943,6 +972,20 @@ export class TspathPlanner extends HTMLElement {
 
   /** Offers the patches of a model of `n`; a patch asked for (URL, attribute, job) that the
    * model does not have is left at auto, and the returned text says so. */
+  /** The glossary list, and its terms marked where the controls name them. */
+  #buildGlossary() {
+    const dl = this.$('glossary');
+    for (const [term, def] of GLOSSARY) {
+      const dt = document.createElement('dt');
+      dt.textContent = term;
+      const dd = document.createElement('dd');
+      dd.textContent = def;
+      dl.append(dt, dd);
+    }
+    markTerms(this.$('params'));
+    markTerms(this.root.querySelector('.layers'));
+  }
+
   #fillPatchChoices(n) {
     const dropped = [];
     for (const key of ['start-patch', 'finish-patch']) {
@@ -1690,8 +1733,10 @@ export class TspathPlanner extends HTMLElement {
     this.$('play').disabled = true;
     this.$('tool-readout').textContent = 'no path yet';
     this.$('listing').replaceChildren();
+    this.$('listing-empty').hidden = false;
     this.$('listing-title').textContent = 'G-code';
     this.$('stats').replaceChildren();
+    this.$('stats-empty').hidden = false;
     this.$('notes').replaceChildren();
     this.$('problems').replaceChildren();
     this.$('problems-box').hidden = true;
@@ -1741,6 +1786,8 @@ export class TspathPlanner extends HTMLElement {
       rows.splice(at, 0, ...ISFC_STATS.map(([id, label, f, raw]) => [id, label, f(r, x), raw(r, x)]));
     }
     this.#facts(this.$('stats'), rows);
+    this.$('stats-empty').hidden = true;
+    markTerms(this.$('stats'), 'dt');
     if (v) this.$('stats-error_bound_target_mm').dataset.reached = String(v.error_bound_mm <= v.error_bound_target_mm);
     this.#showProblems();
     const notes = this.$('notes');
@@ -2015,6 +2062,7 @@ export class TspathPlanner extends HTMLElement {
     const first = Math.max(1, Math.min(line - Math.floor(LISTING_LINES / 2), g.lineCount - LISTING_LINES + 1));
     const last = Math.min(g.lineCount, first + LISTING_LINES - 1);
     ol.start = first;
+    this.$('listing-empty').hidden = true;
     const items = [];
     for (let l = first; l <= last; l++) {
       const li = document.createElement('li');

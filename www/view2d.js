@@ -6,7 +6,7 @@
 // control mesh, the path by kind and the tool as its outline. Same interface as View3D. Z is
 // up; mm.
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, STOCK, ZERO_TRIAD, boxEdges, heatColour, hexCss, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, STOCK, VIEWS, GRID, ZERO_TRIAD, boxEdges, heatColour, hexCss, pathColour, tableGrid,
 } from './colours.js';
 
 const rgb = (c) => [c >> 16 & 255, c >> 8 & 255, c & 255];
@@ -28,7 +28,9 @@ export class View2D {
     this.isfc = null;
     this.center = [0, 0, 0];
     this.radius = 1;
-    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true, zero: true };
+    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true, zero: true, grid: true };
+    /** The drawing is always a parallel projection. */
+    this.ortho = true;
     this.#bindInput();
     this.resizer = new ResizeObserver(() => this.resize());
     this.resizer.observe(canvas);
@@ -91,8 +93,16 @@ export class View2D {
     this.render();
   }
 
-  fit() {
+  /** Centres the model and frames it; from the standard view `name` (VIEWS) if given. */
+  fit(name = null) {
     if (!this.model) return;
+    if (VIEWS[name]) {
+      const d = VIEWS[name];
+      const n = Math.hypot(...d);
+      this.pitch = Math.max(-1.55, Math.min(1.55, Math.asin(d[2] / n)));
+      if (Math.hypot(d[0], d[1]) > 1e-3 * n) this.yaw = Math.atan2(-d[0], -d[1]);
+      else this.yaw = 0;
+    }
     const p = this.model.positions;
     const lo = [Infinity, Infinity, Infinity];
     const hi = [-Infinity, -Infinity, -Infinity];
@@ -127,6 +137,9 @@ export class View2D {
   get modelRadius() {
     return this.radius;
   }
+
+  /** The 2D drawing is always orthographic (parallel). */
+  setOrtho() {}
 
   #project() {
     const { width, height } = this.canvas;
@@ -168,6 +181,7 @@ export class View2D {
     if (!this.model) return;
     const proj = this.#project();
     const overlays = this.#overlays();
+    if (this.layers.grid) this.#drawGrid(proj);
     if (this.layers.surface || overlays.length) this.#drawSurface(proj, overlays);
     if (this.layers.rest && this.rest) this.#drawRestRings(proj);
     if (this.layers.isfc && this.isfc) this.#drawIsfc(proj);
@@ -327,6 +341,12 @@ export class View2D {
   #drawRects(proj) {
     this.#segments(proj, this.rects.outlines, () => true, RECT_LAYER.outline, 1, 0.9);
     this.#segments(proj, this.rects.arrows, () => true, RECT_LAYER.arrow, 1.5, 1);
+  }
+
+  /** The table grid (see View3D). */
+  #drawGrid(proj) {
+    const grid = tableGrid(this.model.summary?.stock_mm || this.model.summary?.bbox_mm);
+    if (grid) this.#segments(proj, grid.lines, () => true, GRID.line, 1, 0.7);
   }
 
   /** Program zero: the axis triad at the model's origin (see View3D). */

@@ -7,10 +7,11 @@
 import * as THREE from './vendor/three.module.js';
 import { OrbitControls } from './vendor/OrbitControls.js';
 import {
-  BACKGROUND, CAGE_COLOUR, EP_COLOUR, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, STOCK, ZERO_TRIAD, boxEdges, heatColour, pathColour,
+  BACKGROUND, CAGE_COLOUR, EP_COLOUR, GRID, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, STOCK, VIEWS, ZERO_TRIAD, boxEdges, heatColour, pathColour, tableGrid,
 } from './colours.js';
 
 const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
+const FOV_DEG = 35;
 
 export class View3D {
   constructor(canvas) {
@@ -20,7 +21,7 @@ export class View3D {
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.renderer.setClearColor(BACKGROUND, 1);
     this.scene = new THREE.Scene();
-    this.camera = new THREE.PerspectiveCamera(35, 1, 0.1, 1000);
+    this.camera = new THREE.PerspectiveCamera(FOV_DEG, 1, 0.1, 1000);
     this.camera.up.set(0, 0, 1);
     this.scene.add(this.camera);
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x707880, 1.6));
@@ -30,8 +31,9 @@ export class View3D {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.screenSpacePanning = true;
     this.controls.addEventListener('change', () => this.render());
-    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true, zero: true };
+    this.layers = { surface: true, rest: true, isfc: false, rects: false, path: true, tool: true, cage: false, eps: true, zero: true, grid: true };
     this.groups = {};
+    this.ortho = false;
     for (const k of Object.keys(this.layers)) {
       this.groups[k] = new THREE.Group();
       this.scene.add(this.groups[k]);
@@ -48,7 +50,12 @@ export class View3D {
     const w = Math.max(1, this.canvas.clientWidth);
     const h = Math.max(1, this.canvas.clientHeight);
     this.renderer.setSize(w, h, false);
-    this.camera.aspect = w / h;
+    if (this.camera.isOrthographicCamera) {
+      const half = (this.camera.top - this.camera.bottom) / 2;
+      this.#orthoFrustum(half);
+    } else {
+      this.camera.aspect = w / h;
+    }
     this.camera.updateProjectionMatrix();
     this.render();
   }
@@ -147,6 +154,14 @@ export class View3D {
       const eg = new THREE.BufferGeometry();
       eg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(boxEdges(stock)), 3));
       this.groups.zero.add(box, new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ color: STOCK.edge })));
+    }
+    // The table grid: on the lowest plane of the stock (or the part), round spacing.
+    const grid = tableGrid(stock || m.summary?.bbox_mm);
+    if (grid) {
+      const gg = new THREE.BufferGeometry();
+      gg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(grid.lines), 3));
+      this.groups.grid.add(new THREE.LineSegments(gg, new THREE.LineBasicMaterial({ color: GRID.line, transparent: true, opacity: 0.7 })));
+      this.gridSpacing = grid.spacing;
     }
     if (m.cage.length) {
       const cg = new THREE.BufferGeometry();
@@ -392,19 +407,13 @@ export class View3D {
     this.render();
   }
 
-  /** Centres the model and frames it. */
-  fit() {
+  /** Centres the model and frames it, from the standard view `name` (see VIEWS; the
+   * iso view by default). */
+  fit(name = 'iso') {
     if (!this.surface) return;
     const s = this.surface.geometry.boundingSphere;
-    const dir = new THREE.Vector3(-0.6, -1, 1.1).normalize();
-    const dist = s.radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 1.05;
-    this.controls.target.copy(s.center);
-    this.camera.position.copy(s.center).addScaledVector(dir, dist);
-    this.camera.near = Math.max(dist / 1000, 1e-4);
-    this.camera.far = dist * 100;
-    this.camera.updateProjectionMatrix();
-    this.controls.update();
-    this.render();
+    this.focus([s.center.x, s.center.y, s.center.z], s.radius, VIEWS[name] || VIEWS.iso);
+    this.viewName = VIEWS[name] ? name : 'iso';
   }
 
   /** Frames a sphere of `radius` (mm) round `centre`, seen from direction `from` (a unit
@@ -412,13 +421,51 @@ export class View3D {
   focus(centre, radius, from = null) {
     const dir = from ? new THREE.Vector3(...from).normalize()
       : this.camera.position.clone().sub(this.controls.target).normalize();
-    const dist = radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 1.05;
+    const dist = radius / Math.sin(THREE.MathUtils.degToRad(FOV_DEG / 2)) * 1.05;
     this.controls.target.set(...centre);
     this.camera.position.copy(this.controls.target).addScaledVector(dir, dist);
     this.camera.near = Math.max(dist / 1000, 1e-4);
     this.camera.far = Math.max(dist, this.sceneRadius || 1) * 100;
+    if (this.camera.isOrthographicCamera) this.#orthoFrustum(radius * 1.05);
+    this.camera.zoom = 1;
     this.camera.updateProjectionMatrix();
     this.controls.update();
+    this.render();
+  }
+
+  /** The orthographic camera's box: `half` mm high from the centre, to the canvas's aspect. */
+  #orthoFrustum(half) {
+    const aspect = this.canvas.clientWidth / Math.max(1, this.canvas.clientHeight) || 1;
+    Object.assign(this.camera, { left: -half * aspect, right: half * aspect, top: half, bottom: -half });
+  }
+
+  /** Switches between the perspective and the orthographic (parallel, true-scale) camera,
+   * keeping where it looks from and what it frames. */
+  setOrtho(on) {
+    if (!!on === this.camera.isOrthographicCamera) return;
+    const old = this.camera;
+    const target = this.controls.target.clone();
+    const dist = old.position.distanceTo(target);
+    const cam = on ? new THREE.OrthographicCamera(-1, 1, 1, -1, old.near, old.far)
+      : new THREE.PerspectiveCamera(FOV_DEG, old.aspect || 1, old.near, old.far);
+    cam.up.copy(old.up);
+    cam.position.copy(old.position);
+    for (const c of [...old.children]) cam.add(c); // the light follows the viewer
+    this.scene.remove(old);
+    this.scene.add(cam);
+    this.camera = cam;
+    if (on) {
+      // What the perspective camera showed at the target, as large.
+      const half = dist * Math.tan(THREE.MathUtils.degToRad(FOV_DEG / 2)) / (old.zoom || 1);
+      this.#orthoFrustum(half);
+    } else {
+      cam.aspect = this.canvas.clientWidth / Math.max(1, this.canvas.clientHeight) || 1;
+    }
+    cam.lookAt(target);
+    cam.updateProjectionMatrix();
+    this.controls.object = cam;
+    this.controls.update();
+    this.ortho = !!on;
     this.render();
   }
 

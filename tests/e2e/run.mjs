@@ -1605,6 +1605,67 @@ test('stock and program zero: at the stock\'s top corner and at a typed point, a
   return `stock ${stockRow}; zero “${shown}”; G-code = CLI (${g.length} bytes); layer ${withStock} px; typed (1.5, -2, 3) as the CLI's`;
 });
 
+test('viewer basics: standard views, orthographic camera, table grid; legends beside the model; glossary on hover and focus; placeholders in empty panels', async (page, url) => {
+  await page.goto(`${url}?model=keycap-convex&scallop=0.05&${SIM}`);
+  await waitState(page, 'model-loaded');
+  // Empty panels say what will appear there.
+  const empty = await page.evaluate((h) => {
+    const r = document.querySelector(h).shadowRoot;
+    return ['stats-empty', 'listing-empty'].map((id) => ({ shown: !r.getElementById(id).hidden, text: r.getElementById(id).textContent }));
+  }, HOST);
+  check(empty.every((e) => e.shown && e.text.length > 30), `placeholders before planning: ${JSON.stringify(empty)}`);
+  // Standard views: the camera looks from where each says.
+  const dirs = {};
+  for (const v of ['top', 'front', 'side', 'iso']) {
+    await page.click(`[data-view="${v}"]`);
+    dirs[v] = await host(page, (el) => {
+      const c = el.view.camera.position.clone().sub(el.view.controls.target).normalize();
+      return [c.x, c.y, c.z];
+    });
+  }
+  const near = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]) < 1e-3;
+  check(near(dirs.top, [0, 0, 1]) && near(dirs.front, [0, -1, 0]) && near(dirs.side, [1, 0, 0]), `views from ${JSON.stringify(dirs)}`);
+  // Orthographic: same view, parallel projection, the model still framed; back again.
+  await page.click('[data-view="front"]');
+  const persp = await host(page, (el) => el.countPixels().drawn);
+  await page.check('#ortho');
+  const ortho = await host(page, (el) => ({ is: el.view.camera.isOrthographicCamera, drawn: el.countPixels().drawn }));
+  check(ortho.is && ortho.drawn > 0.5 * persp && ortho.drawn < 2 * persp, `orthographic: ${JSON.stringify(ortho)} px (perspective ${persp} px)`);
+  await page.click('#fit');
+  const fitted = await host(page, (el) => el.countPixels().drawn);
+  check(fitted > 1000, `fit in orthographic draws the model (${fitted} px)`);
+  await page.uncheck('#ortho');
+  check(await host(page, (el) => el.view.camera.isPerspectiveCamera), 'perspective again');
+  // The grid on the table, its spacing in its label.
+  const gridText = (await page.textContent('#grid-text')).trim();
+  const gridPx = await host(page, (el) => el.layerPixels('grid'));
+  check(/^Grid \(2 mm\)$/.test(gridText) && gridPx > 500, `grid “${gridText}”, ${gridPx} px`);
+  // Plan; the placeholders go; the heat map's legend is beside the view, not over it.
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  await waitVerified(page);
+  const gone = await page.evaluate((h) => ['stats-empty', 'listing-empty'].map((id) => document.querySelector(h).shadowRoot.getElementById(id).hidden), HOST);
+  check(gone.every(Boolean), `placeholders hidden once planned: ${gone}`);
+  await page.check('#colour-heat');
+  const legend = await page.locator('#heat-legend').boundingBox();
+  const view = await page.locator('#view').boundingBox();
+  const overlap = legend && !(legend.y >= view.y + view.height || legend.y + legend.height <= view.y || legend.x >= view.x + view.width || legend.x + legend.width <= view.x);
+  check(legend && !overlap, `the heat legend ${JSON.stringify(legend)} is outside the view ${JSON.stringify(view)}`);
+  // Glossary: terms marked where they are used; focus shows the definition; the list.
+  const term = page.locator('#stats .term').first();
+  await term.focus();
+  const shown = await term.evaluate((t) => ({ text: t.textContent, def: t.dataset.definition, after: getComputedStyle(t, '::after').content }));
+  check(shown.def && shown.after.includes(shown.def.slice(0, 20)), `focus shows the definition: ${JSON.stringify(shown)}`);
+  const terms = await page.evaluate((h) => [...document.querySelector(h).shadowRoot.querySelectorAll('.term')].map((t) => t.textContent.toLowerCase()), HOST);
+  for (const t of ['cl point', 'retraction', 'reversal', 'extraordinary point']) {
+    check(terms.some((x) => x.startsWith(t)), `“${t}” is marked (${terms.length} terms: ${terms.join(', ')})`);
+  }
+  const listed = await page.locator('#glossary dt').count();
+  check(listed >= 20, `the glossary lists ${listed} terms`);
+  await page.screenshot({ path: join(shots, 'viewer-basics.png') });
+  return `views ok; orthographic ${ortho.drawn} px vs ${persp}; ${gridText} ${gridPx} px; ${terms.length} terms marked, ${listed} in the glossary; “${shown.text}”: ${shown.def.slice(0, 40)}…`;
+});
+
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
   const axePath = join(root, 'tests', 'e2e', 'node_modules', 'axe-core', 'axe.min.js');
   const audit = async (what) => {
