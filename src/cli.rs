@@ -18,6 +18,7 @@ const USAGE: &str = "usage:
               [--isfc-plain] [--slice-angle DEG] [--no-deform] [--shear]
               [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
               [--plunge-feed MM_PER_MIN] [--clearance MM] [--feed-height MM]
+              [--max-cl-points N]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--axis-preset vertical|gan2014|yuan2012]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
@@ -53,6 +54,8 @@ and the stock.
 --clearance is the safe plane's height above the model (default 5 mm); the tool rapids
 down to --feed-height above each cut (default 2 mm, along its way down) and goes on at
 --plunge-feed (default 300 mm/min).
+--max-cl-points (default 2 000 000) refuses, before planning, settings whose estimated CL
+points exceed it, naming the estimate and the scallop that would fit.
 --axis-preset gan2014 leads the tool 10° from the surface normal along the feed, as the
 space-filling-curve paper machined (five-axis machines); --lead/--tilt after it override.
 --machine is a built-in machine (default 3-axis) or a machine JSON file (start from
@@ -344,6 +347,7 @@ const PLAN_FLAGS: &[&str] = &[
     "--plunge-feed",
     "--clearance",
     "--feed-height",
+    "--max-cl-points",
     "-o",
     "--report",
     "--verify-samples",
@@ -394,6 +398,14 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     }
     if let Some(v) = a.number("--feed-height")? {
         opts.feed_height_mm = v;
+    }
+    if let Some(v) = a.number("--max-cl-points")? {
+        if !(v >= 1.0 && v.fract() == 0.0) {
+            return Err(Error::Io(format!(
+                "--max-cl-points: `{v}` is not a count of points (a whole number, 1 or more)"
+            )));
+        }
+        opts.max_cl_points = v as u64;
     }
     if let Some(w) = a.value("--work-offset") {
         let n = w.trim_start_matches(['G', 'g']);

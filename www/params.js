@@ -41,6 +41,7 @@ export const PARAMS = [
   // Accuracy
   { key: 'scallop', field: 'scallop_mm', group: 'accuracy', label: 'Scallop height', unit: 'mm', kind: 'number', min: 0.0005, max: 2, step: 0.001, default: 0.01 },
   { key: 'chordal', field: 'chordal_mm', group: 'accuracy', label: 'Chordal tolerance', unit: 'mm', kind: 'number', min: 0.0001, max: 1, step: 0.001, default: 0.005 },
+  { key: 'max-cl-points', field: 'max_cl_points', group: 'accuracy', label: 'Most CL points (estimated before planning; more is refused)', unit: 'points', kind: 'number', min: 1000, max: 100000000, step: 100000, default: 2000000, integer: true },
   // Tool axis (five-axis machines only)
   { key: 'max-tilt', field: 'max_tilt_deg', group: 'axis', label: 'Largest tilt to clear the holder', unit: '°', kind: 'number', min: 0, max: 135, step: 1, default: 60, fiveAxis: true },
   { key: 'lead', field: 'lead_deg', group: 'axis', label: 'Lead angle', unit: '°', kind: 'number', min: -79, max: 79, step: 1, default: 0, fiveAxis: true },

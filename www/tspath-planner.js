@@ -1233,7 +1233,7 @@ export class TspathPlanner extends HTMLElement {
       result = await this.client.call('plan', [options], (f) => {
         if (token !== this.planToken) return;
         bar.value = f;
-        this.#status(`Planning… ${Math.round(100 * f)} %`);
+        this.#status(`Planning… ${Math.round(100 * f)} % (${((performance.now() - t0) / 1000).toFixed(1)} s)`);
       });
     } catch (e) {
       if (token !== this.planToken) return;

@@ -40,12 +40,12 @@ const MAX_HALVINGS: usize = 40;
 const TUNING_STEPS: usize = 60;
 /// Part of the chordal tolerance the forward steps aim for: the chord is held against the
 /// curve at a few points only, and the rest covers the gap between them (dimensionless).
-const CHORD_MARGIN: f64 = 0.9;
+pub(crate) const CHORD_MARGIN: f64 = 0.9;
 /// Fractions of a forward step where the chord is held against the curve.
 const CHORD_PROBES: [f64; 3] = [0.5, 0.25, 0.75];
 /// Share of the scallop height reserved for the material a straight move leaves where the
 /// surface is concave along the feed (dimensionless); the side steps use the rest.
-const CHORD_SCALLOP_SHARE: f64 = 0.1;
+pub(crate) const CHORD_SCALLOP_SHARE: f64 = 0.1;
 /// Points closer than this fraction of the model size are the same corner.
 const CORNER_MATCH_REL: f64 = 1e-7;
 

@@ -6,6 +6,7 @@
 
 pub mod air;
 pub mod axis;
+pub mod budget;
 pub mod compare;
 pub mod corners;
 pub mod distance;
@@ -34,6 +35,9 @@ pub fn plan(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Planned> {
+    // Settings that would run for minutes are refused first, with the estimate.
+    opts.validate()?;
+    budget::check(model, opts)?;
     match opts.strategy {
         Strategy::Isoparametric => isoparametric::plan(model, opts, progress),
         Strategy::Isfc => isfc::plan(model, opts, progress),

@@ -34,6 +34,11 @@ pub struct PlanOptions {
     /// Default 2 mm, room for a stock allowance or a mis-set tool length to meet the tool
     /// at a feed, not at the rapid rate.
     pub feed_height_mm: f64,
+    /// Most CL points a plan may have, estimated before planning
+    /// ([`super::budget::estimate`]); settings estimated beyond it are refused with the
+    /// estimate. Default 2 000 000: about 1.2 GB at the page's cost per point, what a
+    /// browser tab can hold.
+    pub max_cl_points: u64,
     /// Spindle speed (rev/min). Default 12000 rpm.
     pub spindle_rpm: f64,
     /// Work offset the program runs in: 54 to 59 for G54–G59 (Heidenhain: preset 1–6,
@@ -165,6 +170,7 @@ impl Default for PlanOptions {
             feed_mm_min: 1000.0,
             plunge_feed_mm_min: 300.0,
             feed_height_mm: 2.0,
+            max_cl_points: 2_000_000,
             spindle_rpm: 12000.0,
             work_offset: 54,
             start_patch: None,
@@ -306,6 +312,12 @@ impl PlanOptions {
         positive("clearance_mm", self.clearance_mm, "mm")?;
         positive("feed_mm_min", self.feed_mm_min, "mm/min")?;
         positive("plunge_feed_mm_min", self.plunge_feed_mm_min, "mm/min")?;
+        if self.max_cl_points == 0 {
+            return Err(Error::param(
+                "max_cl_points",
+                "must be at least 1 (the most CL points a plan may have)",
+            ));
+        }
         if !(self.feed_height_mm.is_finite() && self.feed_height_mm >= 0.0) {
             return Err(Error::param(
                 "feed_height_mm",

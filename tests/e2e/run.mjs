@@ -1666,6 +1666,30 @@ test('viewer basics: standard views, orthographic camera, table grid; legends be
   return `views ok; orthographic ${ortho.drawn} px vs ${persp}; ${gridText} ${gridPx} px; ${terms.length} terms marked, ${listed} in the glossary; “${shown.text}”: ${shown.def.slice(0, 40)}…`;
 });
 
+test('bounded work: settings beyond the CL-point limit are refused before planning, with the CLI\'s estimate, and the page stays usable', async (page, url) => {
+  await page.goto(`${url}?model=dome&max-cl-points=20000&scallop=0.005`);
+  await waitState(page, 'model-loaded');
+  const t0 = Date.now();
+  await page.click('#plan');
+  await page.waitForFunction((h) => /max_cl_points/.test(document.querySelector(h).shadowRoot.getElementById('status').textContent), HOST);
+  const ms = Date.now() - t0;
+  const st = (await page.textContent('#status')).trim();
+  let cliSays = '';
+  try {
+    runCli(['plan', 'dome', '--scallop', '0.005', '--tool-radius', '0.5', '--max-cl-points', '20000', '-o', 'refused.nc']);
+  } catch (e) {
+    cliSays = e.stderr || '';
+  }
+  const estimate = (t) => (t.match(/need about ([\d ]+) CL points/) || [])[1];
+  check(estimate(st) && estimate(st) === estimate(cliSays), `the page's estimate is the CLI's: “${st}” vs “${cliSays}”`);
+  check(/raise the scallop height to about/.test(st), `it says what to change: ${st}`);
+  check(await plans(page) === 0 && await attr(page, 'data-state') === 'model-loaded', 'nothing was planned; the model stays');
+  await setParam(page, 'max-cl-points', '2000000');
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  return `refused in ${ms} ms: “${st.slice(0, 110)}…”; planned once the limit was raised`;
+});
+
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
   const axePath = join(root, 'tests', 'e2e', 'node_modules', 'axe-core', 'axe.min.js');
   const audit = async (what) => {
