@@ -378,26 +378,19 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     let m = load_model_with(model, &import_setup(a)?)?;
     let mach = load_machine(a.value("--machine").unwrap_or("3-axis"))?;
     let mut opts = PlanOptions::default();
-    if let Some(v) = a.number("--tool-radius")? {
-        opts.tool_radius_mm = v;
-    }
-    if let Some(v) = a.number("--scallop")? {
-        opts.scallop_mm = v;
-    }
-    if let Some(v) = a.number("--chordal")? {
-        opts.chordal_mm = v;
-    }
-    if let Some(v) = a.number("--feed")? {
-        opts.feed_mm_min = v;
-    }
-    if let Some(v) = a.number("--plunge-feed")? {
-        opts.plunge_feed_mm_min = v;
-    }
-    if let Some(v) = a.number("--clearance")? {
-        opts.clearance_mm = v;
-    }
-    if let Some(v) = a.number("--feed-height")? {
-        opts.feed_height_mm = v;
+    // The options a number sets as it is (checked with the others by `validate`).
+    for (flag, slot) in [
+        ("--tool-radius", &mut opts.tool_radius_mm),
+        ("--scallop", &mut opts.scallop_mm),
+        ("--chordal", &mut opts.chordal_mm),
+        ("--feed", &mut opts.feed_mm_min),
+        ("--plunge-feed", &mut opts.plunge_feed_mm_min),
+        ("--clearance", &mut opts.clearance_mm),
+        ("--feed-height", &mut opts.feed_height_mm),
+    ] {
+        if let Some(v) = a.number(flag)? {
+            *slot = v;
+        }
     }
     if let Some(v) = a.number("--max-cl-points")? {
         if !(v >= 1.0 && v.fract() == 0.0) {
@@ -470,6 +463,14 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
         return Err(Error::Io(
             "a three-axis machine cannot tilt the tool: drop --max-tilt/--lead/--tilt/--axis-preset or choose a five-axis --machine".into(),
         ));
+    }
+    // Every axis the planner chooses must be one the machine can post.
+    let reach = mach.reachable_tilt_deg();
+    if !mach.rotaries.is_empty() && opts.max_tilt_deg > reach {
+        return Err(Error::Io(format!(
+            "--max-tilt {}° is past what {} can tilt the tool ({reach}°, the travel of its tilting axis): use --max-tilt {reach} or less",
+            opts.max_tilt_deg, mach.name
+        )));
     }
     if let Some(name) = a.value("--strategy") {
         opts.strategy = Strategy::parse(name)?;

@@ -6,45 +6,15 @@
 
 mod support;
 
-use support::{dense_samples, extruded_obj, obj_model, public_tsm, tool_clearance, SampleGrid};
+use support::{
+    dense_samples, extruded_obj, obj_model, public_tsm, tool_clearance, torus_obj, SampleGrid,
+};
 use tspath::geom::{Point3, Vector3};
 use tspath::machine::{self, Dialect, JobInfo, Units};
 use tspath::model::samples;
 use tspath::plan::{isoparametric, PlanOptions, PlanStatus, Planned};
 use tspath::verify::{self, gcode::read_tool_poses};
 use tspath::Model;
-
-/// A closed torus cage (Catmull–Clark): `m` × `n` quads on a torus of radii `big` and `small`
-/// (mm) lying on the XY plane.
-fn torus_obj(big: f64, small: f64, m: usize, n: usize) -> String {
-    let mut s = String::new();
-    for i in 0..m {
-        let a = std::f64::consts::TAU * i as f64 / m as f64;
-        for j in 0..n {
-            let b = std::f64::consts::TAU * j as f64 / n as f64;
-            let r = big + small * b.cos();
-            s += &format!(
-                "v {} {} {}\n",
-                r * a.cos(),
-                r * a.sin(),
-                small + small * b.sin()
-            );
-        }
-    }
-    let id = |i: usize, j: usize| (i % m) * n + (j % n) + 1;
-    for i in 0..m {
-        for j in 0..n {
-            s += &format!(
-                "f {} {} {} {}\n",
-                id(i, j),
-                id(i + 1, j),
-                id(i + 1, j + 1),
-                id(i, j + 1)
-            );
-        }
-    }
-    s
-}
 
 /// The program for `planned` on `machine` in `dialect`, read back: for every block with a
 /// workpiece pose, the ball centre and the tool axis.

@@ -17,7 +17,7 @@ export async function engineInfo() {
   return {
     version: w.version(),
     samples: w.sampleNames(),
-    machines: w.machineNames().map((name) => ({ name, json: w.machineJson(name) })),
+    machines: w.machineNames().map((name) => ({ name, json: w.machineJson(name), reachTiltDeg: w.machineReachableTiltDeg(name) })),
     dialects: w.dialectNames(),
     verifyMaxSamples: w.planVerifyMaxSamples(),
     paperLeadDeg: w.paperLeadDeg(),

@@ -88,7 +88,7 @@ export const byKey = Object.fromEntries(PARAMS.map((p) => [p.key, p]));
  * `{values, errors}`: numbers parsed (null where `auto`), and per key a message saying what
  * is wrong. `patches` is the model's patch count, `fiveAxis` whether the machine tilts.
  */
-export function validate(raw, { patches = 1, fiveAxis = false } = {}) {
+export function validate(raw, { patches = 1, fiveAxis = false, reachTiltDeg = 180 } = {}) {
   const values = {};
   const errors = {};
   for (const p of PARAMS) {
@@ -139,6 +139,9 @@ export function validate(raw, { patches = 1, fiveAxis = false } = {}) {
   const flute = v['flute-length'] ?? 4 * v['tool-radius'];
   if (fine('flute-length', 'shank-length', 'tool-radius') && flute >= v['shank-length']) {
     errors['flute-length'] = `Flute length (${flute} mm) must be shorter than the shank length (${v['shank-length']} mm)`;
+  }
+  if (fiveAxis && fine('max-tilt') && v['max-tilt'] > reachTiltDeg) {
+    errors['max-tilt'] = `${byKey['max-tilt'].label} must be at most ${reachTiltDeg}° on this machine (the travel of its tilting axis)`;
   }
   if (!fiveAxis) {
     for (const k of ['lead', 'tilt']) {

@@ -458,7 +458,7 @@ export class TspathPlanner extends HTMLElement {
     this.info = info;
     this.machineRotaries = Object.fromEntries(info.machines.map((m) => {
       const j = JSON.parse(m.json);
-      return [m.name, { rotaries: j.rotaries.length, description: j.description || '' }];
+      return [m.name, { rotaries: j.rotaries.length, description: j.description || '', reachTiltDeg: m.reachTiltDeg }];
     }));
     this.#fillChoice('machine', info.machines.map((m) => [m.name, `${m.name}${this.machineRotaries[m.name].rotaries ? ' (five-axis)' : ''}`]));
     this.#fillChoice('dialect', info.dialects.map((d) => [d, d]));
@@ -820,7 +820,7 @@ export class TspathPlanner extends HTMLElement {
     if (this.planning || this.dataset.verify === 'running') this.#cancel(true);
     // Placed as the placement controls say (when valid; else as modelled, and the field says
     // what is wrong).
-    const placed = validate(this.#raw(), { patches: 1, fiveAxis: this.#fiveAxis });
+    const placed = validate(this.#raw(), { patches: 1, fiveAxis: this.#fiveAxis, reachTiltDeg: this.#reachTilt });
     const bad = PARAMS.filter((p) => p.placement && placed.errors[p.key]);
     source = { ...source, setup: bad.length ? null : placement(placed.values) };
     this.state = 'loading';
@@ -1034,6 +1034,12 @@ export class TspathPlanner extends HTMLElement {
     el.value = v;
   }
 
+  /** How far the chosen machine tilts the tool (degrees). */
+  get #reachTilt() {
+    const m = this.$('p-machine').value;
+    return this.machineRotaries?.[m]?.reachTiltDeg ?? 180;
+  }
+
   get #fiveAxis() {
     const m = this.$('p-machine').value;
     return !!(this.machineRotaries && this.machineRotaries[m] && this.machineRotaries[m].rotaries);
@@ -1074,7 +1080,7 @@ export class TspathPlanner extends HTMLElement {
   #validateAll() {
     const { values, errors } = validate(this.#raw(), {
       patches: this.model ? this.model.summary.patches : 1,
-      fiveAxis: this.#fiveAxis,
+      fiveAxis: this.#fiveAxis, reachTiltDeg: this.#reachTilt,
     });
     for (const p of PARAMS) {
       const el = this.$(`p-${p.key}`);
@@ -1100,7 +1106,7 @@ export class TspathPlanner extends HTMLElement {
       if (key === 'zero') this.#updateDependentControls();
       this.#validateAll();
       this.#syncUrl();
-      const { errors } = validate(this.#raw(), { patches: 1, fiveAxis: this.#fiveAxis });
+      const { errors } = validate(this.#raw(), { patches: 1, fiveAxis: this.#fiveAxis, reachTiltDeg: this.#reachTilt });
       const bad = PARAMS.find((p) => p.placement && errors[p.key]);
       if (bad) {
         this.#status(errors[bad.key], true);
@@ -1150,7 +1156,7 @@ export class TspathPlanner extends HTMLElement {
   }
 
   #planOptions(values) {
-    return planOptions(values, { fiveAxis: this.#fiveAxis, paperLeadDeg: this.info?.paperLeadDeg });
+    return planOptions(values, { fiveAxis: this.#fiveAxis, reachTiltDeg: this.#reachTilt, paperLeadDeg: this.info?.paperLeadDeg });
   }
 
   /** Whether the plan shown is the plan of the parameters as they are now: every plan
@@ -1159,7 +1165,7 @@ export class TspathPlanner extends HTMLElement {
     if (!this.plan) return false;
     const { values, errors } = validate(this.#raw(), {
       patches: this.model ? this.model.summary.patches : 1,
-      fiveAxis: this.#fiveAxis,
+      fiveAxis: this.#fiveAxis, reachTiltDeg: this.#reachTilt,
     });
     if (PARAMS.some((p) => p.field && errors[p.key])) return false;
     return JSON.stringify(this.#planOptions(values)) === JSON.stringify(this.plan.options);
@@ -1665,7 +1671,7 @@ export class TspathPlanner extends HTMLElement {
   async #verify() {
     if (!this.plan) return;
     const plan = this.plan;
-    const { values, errors } = validate(this.#raw(), { patches: this.model.summary.patches, fiveAxis: this.#fiveAxis });
+    const { values, errors } = validate(this.#raw(), { patches: this.model.summary.patches, fiveAxis: this.#fiveAxis, reachTiltDeg: this.#reachTilt });
     if (errors.samples || errors['max-samples']) return;
     const token = (this.verifyToken = (this.verifyToken || 0) + 1);
     this.dataset.verify = 'running';

@@ -79,6 +79,10 @@ pub enum Kinematics {
     HeadTable,
 }
 
+/// Largest |z| of a rotary axis that tilts the tool (a horizontal axis; an axis nearer
+/// vertical turns it about Z).
+const TILT_AXIS_MAX_Z: f64 = 0.5;
+
 /// A machine: its rotaries and travel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Machine {
@@ -196,6 +200,33 @@ struct OrientationForm {
 }
 
 impl Machine {
+    /// How far the machine can tilt the tool axis from +Z (degrees): 0 without rotaries;
+    /// else the travel of the rotary that tilts (its axis horizontal) — the larger side of
+    /// it when the other rotary turns the whole circle (either side then reaches every
+    /// azimuth), the smaller side when that one is limited too; 180° for a tilting axis
+    /// without limits. The planners' largest tilt must stay within it, so that every axis
+    /// they choose can be posted.
+    pub fn reachable_tilt_deg(&self) -> f64 {
+        let horizontal = |r: &Rotary| r.axis.z.abs() < TILT_AXIS_MAX_Z;
+        let Some(tilt) = self.rotaries.iter().find(|r| horizontal(r)) else {
+            return 0.0;
+        };
+        let Some((lo, hi)) = tilt.limits_deg else {
+            return 180.0;
+        };
+        let spin_full = self
+            .rotaries
+            .iter()
+            .filter(|r| !horizontal(r))
+            .all(|r| r.limits_deg.is_none_or(|(a, b)| b - a >= 360.0));
+        let reach = if spin_full {
+            lo.abs().max(hi.abs())
+        } else {
+            lo.abs().min(hi.abs())
+        };
+        reach.min(180.0)
+    }
+
     /// The kinematics the rotaries make (checked by [`Machine::validate`]).
     pub fn kinematics(&self) -> Kinematics {
         match self.rotaries.len() {

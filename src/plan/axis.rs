@@ -717,6 +717,21 @@ pub fn bridge_turns(
     });
 }
 
+/// A unit vector perpendicular to unit `n`.
+fn any_tangent(n: &Vector3) -> Vector3 {
+    let other = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    n.cross(&other).normalize()
+}
+
+/// Whether unit axis `a` leans from +Z by no more than the largest tilt allowed.
+fn within_tilt(a: &Vector3, opts: &PlanOptions) -> bool {
+    a.z >= opts.max_tilt_deg.max(0.0).to_radians().cos()
+}
+
 /// Shortest interpolated axis (before normalising) taken as a direction.
 const AXIS_MIN_NORM: f64 = 1e-9;
 
@@ -759,20 +774,25 @@ pub fn choose(
                 (Some(p), None) => m.cc_point - p,
                 _ => Vector3::x(),
             };
+            // In the tangent plane; where the feed is along the normal or nil (a lifted
+            // point's contact repeated), any tangent: the frame must stay orthonormal, or
+            // the rotations below give an axis that is not a unit vector.
             let feed = (feed - normal * feed.dot(&normal))
-                .try_normalize(1e-12)
-                .unwrap_or_else(Vector3::x);
+                .try_normalize(AXIS_MIN_NORM)
+                .unwrap_or_else(|| any_tangent(&normal));
             let side = normal.cross(&feed);
             let a = rotate(&normal, &side, opts.lead_deg.to_radians());
             let a = rotate(&a, &feed, opts.tilt_deg.to_radians());
-            if usable(obs, (&c, &normal), &a, opts) {
+            // Within the largest tilt (issue 19: on a part's underside the normal with its
+            // lead pointed up to 180° from +Z); else the search below, which keeps to it.
+            if within_tilt(&a, opts) && usable(obs, (&c, &normal), &a, opts) {
                 axis = a;
             }
         } else if opts.facet_normal_axis && m.tool_axis != Vector3::z() {
             // The strategy's own axis (iso-planar: the facets' area-weighted normal), within
             // the largest tilt.
             let a = m.tool_axis;
-            if a.z >= opts.max_tilt_deg.to_radians().cos() && usable(obs, (&c, &normal), &a, opts) {
+            if within_tilt(&a, opts) && usable(obs, (&c, &normal), &a, opts) {
                 axis = a;
             }
         }

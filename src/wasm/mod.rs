@@ -74,6 +74,15 @@ pub fn machine_json(name: &str) -> Result<String, JsError> {
         .map_err(js_err)
 }
 
+/// How far a built-in machine can tilt the tool from +Z (degrees; 0 for three axes): the
+/// page's largest tilt must stay within it.
+#[wasm_bindgen(js_name = machineReachableTiltDeg)]
+pub fn machine_reachable_tilt_deg(name: &str) -> Result<f64, JsError> {
+    machine::builtin(name)
+        .map(|m| m.reachable_tilt_deg())
+        .map_err(js_err)
+}
+
 /// Most samples a plan's cutting simulation grows to while aiming for its error bound
 /// unless told otherwise (`max_samples` of `Model.verify`): the same cap as
 /// `tspath plan --verify` uses, so the page's default measures a plan as the CLI does.

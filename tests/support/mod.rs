@@ -228,3 +228,35 @@ pub fn extruded_obj(profile: &[(f64, f64)], ny: usize, dy: f64, triangles: bool)
 pub fn obj_model(text: &str, name: &str) -> Model {
     io::load(text.as_bytes(), name).unwrap()
 }
+
+/// A closed torus cage (Catmull–Clark): `m` × `n` quads on a torus of radii `big` and `small`
+/// (mm) lying on the XY plane.
+pub fn torus_obj(big: f64, small: f64, m: usize, n: usize) -> String {
+    let mut s = String::new();
+    for i in 0..m {
+        let a = std::f64::consts::TAU * i as f64 / m as f64;
+        for j in 0..n {
+            let b = std::f64::consts::TAU * j as f64 / n as f64;
+            let r = big + small * b.cos();
+            s += &format!(
+                "v {} {} {}\n",
+                r * a.cos(),
+                r * a.sin(),
+                small + small * b.sin()
+            );
+        }
+    }
+    let id = |i: usize, j: usize| (i % m) * n + (j % n) + 1;
+    for i in 0..m {
+        for j in 0..n {
+            s += &format!(
+                "f {} {} {} {}\n",
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j + 1)
+            );
+        }
+    }
+    s
+}

@@ -29,7 +29,7 @@ pub mod tree;
 
 use self::cells::{Cell, Link, PatchGrid, Vertex, Weights};
 use super::draft::{Draft, DraftBuilder, Footprint, SurfacePoint};
-use super::isoparametric::{patch_views, predicted, ParamSurface, PatchView};
+use super::isoparametric::{patch_views, predicted, ParamSurface, PatchView, CHORD_SCALLOP_SHARE};
 use super::pipeline::Planned;
 use super::stepover::FeedDir;
 use super::PlanOptions;
@@ -81,9 +81,6 @@ pub struct IsfcStats {
     pub start_mm: [f64; 3],
 }
 
-/// Share of the scallop height reserved for the material straight moves leave over concave
-/// stretches (as the isoparametric planner does).
-const CHORD_SCALLOP_SHARE: f64 = 0.1;
 /// Part of the chordal tolerances the chords aim for (the chord is checked at a few points).
 const CHORD_MARGIN: f64 = 0.9;
 /// Most halvings of a stretch while meeting the chordal tolerance.
