@@ -71,6 +71,7 @@ const PROBLEM_KINDS = {
   scallop_predicted: 'Scallop above the request (predicted)',
   gouge: 'Gouge',
   unproven: 'Not proven by the simulation',
+  model_not_as_modelled: 'Surface not as modelled',
 };
 
 /** The comparison's rows as `tspath compare` names them, with the strategy control's value
@@ -868,8 +869,10 @@ export class TspathPlanner extends HTMLElement {
     const { errors } = this.#validateAll();
     // A wrong value from the URL or an attribute is said at once, not only at its field.
     const patches = `${int(m.summary.patches)} ${m.summary.patches === 1 ? 'patch' : 'patches'}`;
-    if (errors) this.#status(`Loaded ${m.summary.name}: ${patches}. Before planning: ${errors[0]}${patchNote}`, true);
-    else if (patchNote) this.#status(`Loaded ${m.summary.name}: ${patches}.${patchNote}`, 'warning');
+    // What the reader could not apply (OBJ subdivision tags) is said as loudly as a problem.
+    const readerNote = (m.summary.warnings || []).map((w) => ` Warning: ${w}.`).join('');
+    if (errors) this.#status(`Loaded ${m.summary.name}: ${patches}. Before planning: ${errors[0]}${patchNote}${readerNote}`, true);
+    else if (patchNote || readerNote) this.#status(`Loaded ${m.summary.name}: ${patches}.${patchNote}${readerNote}`, 'warning');
     else this.#status(`Loaded ${m.summary.name}: ${patches}. Choose parameters and plan.`);
     this.#syncUrl();
     return true;

@@ -99,7 +99,10 @@ pub fn load_with(bytes: &[u8], name: &str, setup: &ImportSetup) -> Result<Model>
                 Some(u) => u.name().to_string(),
                 None => "mm (assumed)".to_string(),
             };
-            Model::try_new_placed(name, "obj", &units, obj::read(&text)?, setup, None)
+            let (mesh, warnings) = obj::read(&text)?;
+            let mut m = Model::try_new_placed(name, "obj", &units, mesh, setup, None)?;
+            m.warnings = warnings;
+            Ok(m)
         }
         Format::Tsm => {
             let (mesh, meta) = tsm::read(bytes)?;

@@ -3,7 +3,10 @@
 //! interpolated, as OpenSubdiv does with edge-and-corner boundary interpolation.
 //!
 //! `v x y z [w]` and `f a b c ...` (also `a/t/n` forms and negative indices) are read;
-//! other records (`vt`, `vn`, `g`, `o`, `s`, `usemtl`, ...) are skipped. A cage with faces that
+//! other records (`vt`, `vn`, `g`, `o`, `s`, `usemtl`, ...) are skipped. Subdivision tags
+//! (`t crease`, `t corner`, `t interpolateboundary`, `t hole`) are not applied yet: each is
+//! returned as a warning naming its line, so that a surface made smooth where the modeller
+//! marked it sharp is said, not hidden; any other `t` tag is refused. A cage with faces that
 //! are not quadrilaterals is subdivided once (which makes every face a quadrilateral and
 //! leaves the limit surface unchanged). Vertices no face uses are dropped.
 
@@ -14,12 +17,20 @@ use std::collections::{HashMap, HashSet};
 
 const FORMAT: &str = "obj";
 
-/// Reads an OBJ cage. Coordinates are taken as millimetres.
+/// The subdivision tags OBJ cages from modelling tools carry.
+const KNOWN_TAGS: [&str; 4] = ["crease", "corner", "interpolateboundary", "hole"];
+
+/// Reads an OBJ cage. Coordinates are taken as millimetres. Returns the mesh and a warning
+/// per kind of subdivision tag the file has that is not applied (with its count and first
+/// line).
 ///
 /// Errors name the line at fault, with vertices numbered as in the file (from 1): bad
-/// records, and the topology a surface cannot have (an edge shared by more than two faces,
-/// neighbouring faces oriented inconsistently, faces meeting only at a vertex).
-pub fn read(text: &str) -> Result<TMesh> {
+/// records, unknown `t` tags, and the topology a surface cannot have (an edge shared by more
+/// than two faces, neighbouring faces oriented inconsistently, faces meeting only at a
+/// vertex).
+pub fn read(text: &str) -> Result<(TMesh, Vec<String>)> {
+    // Tag name -> (count, first line).
+    let mut tags: Vec<(&str, usize, usize)> = Vec::new();
     let mut pts: Vec<Vector4> = Vec::new();
     // Line (1-based) of each vertex and face record.
     let mut vertex_line: Vec<usize> = Vec::new();
@@ -93,9 +104,40 @@ pub fn read(text: &str) -> Result<TMesh> {
                 faces.push(face);
                 face_line.push(ln + 1);
             }
+            Some("t") => {
+                let tag = words.next().unwrap_or("");
+                let Some(known) = KNOWN_TAGS.iter().find(|k| **k == tag) else {
+                    return Err(Error::parse(
+                        FORMAT,
+                        loc(),
+                        format!(
+                            "`t {tag}` is not a subdivision tag this reader knows ({})",
+                            KNOWN_TAGS.join(", ")
+                        ),
+                    ));
+                };
+                match tags.iter_mut().find(|t| t.0 == *known) {
+                    Some(t) => t.1 += 1,
+                    None => tags.push((known, 1, ln + 1)),
+                }
+            }
             _ => {}
         }
     }
+    let warnings = tags
+        .iter()
+        .map(|(tag, n, line)| {
+            format!(
+                "the file's {n} `t {tag}` tag(s) (first at line {line}) are not applied: the surface is read as plain Catmull–Clark (smooth where the modeller marked {}); check it before cutting",
+                match *tag {
+                    "crease" => "creases",
+                    "corner" => "sharp corners",
+                    "hole" => "holes, which are surfaced",
+                    _ => "how the boundary is interpolated",
+                }
+            )
+        })
+        .collect();
     if faces.is_empty() {
         return Err(Error::parse(
             FORMAT,
@@ -131,7 +173,8 @@ pub fn read(text: &str) -> Result<TMesh> {
         .iter()
         .map(|f| FaceLoop::quad(f[0], f[1], f[2], f[3]))
         .collect();
-    TMesh::try_new(points, &loops, &HashMap::new(), 1.0, Scheme::CatmullClark)
+    let mesh = TMesh::try_new(points, &loops, &HashMap::new(), 1.0, Scheme::CatmullClark)?;
+    Ok((mesh, warnings))
 }
 
 /// "lines 3 and 7", "lines 3, 7 and 9".

@@ -29,6 +29,9 @@ pub struct Model {
     pub stock: Aabb,
     /// Where the program's zero is ([`setup::ProgramZero::describe`]).
     pub program_zero: String,
+    /// What the reader could not apply (OBJ subdivision tags), for a person: every plan of
+    /// the model lists these among its problems.
+    pub warnings: Vec<String>,
     pub mesh: TMesh,
     pub surface: Surface,
     pub layout: PatchLayout,
@@ -69,6 +72,8 @@ pub struct ModelSummary {
     pub stock_mm: Aabb,
     /// Where the program's zero (X0 Y0 Z0 of the work offset) is, in words.
     pub program_zero: String,
+    /// What the reader could not apply ([`Model::warnings`]).
+    pub warnings: Vec<String>,
     pub vertices: usize,
     pub faces: usize,
     pub control_points: usize,
@@ -91,6 +96,7 @@ impl Model {
             layout,
             stock: surface.bbox(),
             program_zero: setup::ProgramZero::Model.describe(),
+            warnings: Vec::new(),
             name: name.to_string(),
             format: format.to_string(),
             units_read: units_read.to_string(),
@@ -153,6 +159,7 @@ impl Model {
             placement: self.placement.clone(),
             stock: self.stock,
             program_zero: self.program_zero.clone(),
+            warnings: self.warnings.clone(),
             mesh: self.mesh.clone(),
             surface: self.surface.clone(),
             layout,
@@ -278,6 +285,7 @@ impl Model {
             placement: self.placement.clone(),
             stock_mm: self.stock,
             program_zero: self.program_zero.clone(),
+            warnings: self.warnings.clone(),
             vertices: nv,
             faces: self.mesh.faces().len(),
             control_points: nv,

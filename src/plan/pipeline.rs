@@ -68,6 +68,8 @@ pub struct Planned {
     pub watershed_layer: Option<super::watershed::layer::Layer>,
     /// What the slices are made of (`isoplanar` only).
     pub isoplanar: Option<super::isoplanar::IsoplanarStats>,
+    /// The model's reader warnings, listed among the report's problems.
+    pub model_warnings: Vec<String>,
 }
 
 /// Plans with a strategy: `draft` makes its draft, reporting on the first `draft_share` of
@@ -194,6 +196,7 @@ pub fn finish(
     let area = model_area(model);
     progress(1.0);
     Ok(Planned {
+        model_warnings: model.warnings.clone(),
         isfc: draft.isfc,
         isoplanar: draft.isoplanar,
         isfc_layer: None,
@@ -491,6 +494,15 @@ impl Planned {
                     "the passes leave cusps up to {:.4} mm (predicted), above the requested {} mm",
                     r.max_predicted_scallop_mm, opts.scallop_mm
                 ),
+                count: 1,
+                at_mm: None,
+                near_move: None,
+            });
+        }
+        for w in &self.model_warnings {
+            r.problems.push(Problem {
+                kind: "model_not_as_modelled".into(),
+                message: w.clone(),
                 count: 1,
                 at_mm: None,
                 near_move: None,

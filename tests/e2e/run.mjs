@@ -1709,6 +1709,23 @@ test('the largest tilt stays within what the machine reaches: 135° on table-tab
   return `“${err}”; head-table-bc: “${err2}”`;
 });
 
+test('an OBJ cage with crease tags: the page says they are not applied, on loading and among the plan\'s problems', async (page, url) => {
+  await page.goto(`${url}?model=dome`);
+  await waitState(page, 'model-loaded');
+  const obj = `${extrudedObj()}t crease 2/1/0 7 8 2.0\n`;
+  await page.setInputFiles('#file', { name: 'creased.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'creased' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
+  const st = (await page.textContent('#status')).trim();
+  const tone = await page.evaluate((h) => document.querySelector(h).shadowRoot.getElementById('status').className, HOST);
+  check(/`t crease`/.test(st) && /not applied/.test(st) && /warning/.test(tone), `said on loading, as a warning: “${st}” (${tone})`);
+  await page.click('#plan');
+  await waitPlans(page, 1);
+  check(await attr(page, 'data-status') === 'planned_with_problems', 'the plan has problems');
+  const problems = await page.textContent('#problems');
+  check(/Surface not as modelled/.test(problems) && /t crease/.test(problems), `listed among the problems: ${problems.slice(0, 200)}`);
+  return `“${st.slice(0, 120)}…”`;
+});
+
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
   const axePath = join(root, 'tests', 'e2e', 'node_modules', 'axe-core', 'axe.min.js');
   const audit = async (what) => {
