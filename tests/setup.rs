@@ -312,3 +312,61 @@ fn the_program_zero_goes_where_the_stock_says() {
         assert!(e.contains(what), "{flags:?}: {e}");
     }
 }
+
+/// Stock declared above the part (issue 18 review): the safe plane clears the stock's top,
+/// and every approach rapids down no lower than the feed height above it; without top
+/// stock the approaches are as before (the feed height above the cut).
+#[test]
+fn rapids_keep_above_the_declared_stock() {
+    use tspath::plan::{self, MoveKind, PlanOptions};
+    let keycap = tspath::model::samples::sample_json("keycap-convex").unwrap();
+    let o = PlanOptions::default()
+        .with_tool_radius(0.5)
+        .with_scallop(0.05);
+    let r = o.tool_radius_mm;
+    for top in [0.0, 4.0] {
+        let setup = ImportSetup {
+            stock_top_mm: top,
+            zero: ProgramZero::StockTopCentre,
+            ..ImportSetup::default()
+        };
+        let m = io::load_with(keycap.as_bytes(), "keycap", &setup).unwrap();
+        assert!(m.stock.max[2].abs() < 1e-9, "zero at the stock's top");
+        let path = plan::plan(&m, &o, &mut |_| true).unwrap().toolpath;
+        let highest = path
+            .moves
+            .iter()
+            .map(|mv| mv.cl_point.z)
+            .fold(f64::MIN, f64::max);
+        assert!(
+            highest >= 2.0 * r + o.clearance_mm - 1e-9,
+            "safe plane {highest} mm"
+        );
+        let mut approaches = 0;
+        let moves = &path.moves;
+        for i in 1..moves.len() {
+            if !(moves[i - 1].kind == MoveKind::Rapid && moves[i].kind.at_plunge_feed()) {
+                continue;
+            }
+            approaches += 1;
+            let tip = moves[i - 1].cl_point.z - r;
+            let plunge = moves[i..]
+                .iter()
+                .find(|x| x.kind == MoveKind::Plunge)
+                .unwrap();
+            let cut = plunge.cl_point.z - r;
+            // With top stock, the feed height counts from the stock's top (Z 0 here).
+            let want = if top > 0.0 {
+                o.feed_height_mm.max(o.feed_height_mm - cut)
+            } else {
+                o.feed_height_mm
+            };
+            assert!(
+                tip - cut >= want - 1e-6,
+                "top stock {top} mm: the rapid ends {} mm above the cut at {cut} mm",
+                tip - cut
+            );
+        }
+        assert!(approaches >= 1);
+    }
+}

@@ -762,15 +762,28 @@ export class TspathPlanner extends HTMLElement {
       return false;
     }
     const unknown = Object.keys(job.parameters).filter((k) => !byKey[k]);
-    for (const p of PARAMS) this.#setControl(p, job.parameters[p.key] ?? defaultText(p));
+    const before = this.#raw();
+    const setAll = (values) => {
+      for (const p of PARAMS) this.#setControl(p, values[p.key] ?? defaultText(p));
+      this.#updateDependentControls();
+      this.#validateAll();
+    };
+    setAll(job.parameters);
     this.pendingPatches = { 'start-patch': job.parameters['start-patch'], 'finish-patch': job.parameters['finish-patch'] };
-    this.#updateDependentControls();
-    this.#validateAll();
     const m = job.model;
     const loaded = m.sample
       ? await this.#loadNamed(m.sample)
       : await this.#load({ bytes: m.bytes, name: m.file.replace(/\.[^.]*$/, '') }, m.file);
-    if (!loaded) return false;
+    if (!loaded) {
+      // The model shown stays, with the parameters it was shown with: the job's would not
+      // describe it (its placement, its zero), and the plan shown stays that plan's.
+      const said = this.$('status').textContent;
+      setAll(before);
+      this.pendingPatches = null;
+      this.#markStale(!!this.plan && !this.#planMatches());
+      this.#status(`Could not open the job ${name}: ${said}`, true);
+      return false;
+    }
     if (unknown.length) {
       this.#status(`Opened the job ${name}, but its ${unknown.map((k) => `“${k}”`).join(', ')} ${unknown.length === 1 ? 'is not a parameter' : 'are not parameters'} of this page (left out): check the parameters, then plan.`, 'warning');
       return true;
@@ -798,7 +811,9 @@ export class TspathPlanner extends HTMLElement {
 
   async #openFile(file) {
     const ext = (file.name.match(/\.[^.]*$/) || [''])[0].toLowerCase();
-    if (file.size > MAX_FILE_BYTES) {
+    // A job holds its model in base64 (4/3 of its bytes) beside the parameters.
+    const jobRoom = /\.json$/i.test(file.name) ? (MAX_FILE_BYTES * 4) / 3 + 1048576 : MAX_FILE_BYTES;
+    if (file.size > jobRoom) {
       this.#status(`Could not open ${file.name}: it is ${bytes(file.size)}, more than the ${bytes(MAX_FILE_BYTES)} this page reads.`, true);
       return false;
     }
@@ -1502,7 +1517,7 @@ export class TspathPlanner extends HTMLElement {
       const x = (i) => PAD + (cl[3 * i] - lo[0]) * scale;
       const y = (i) => H - PAD - (cl[3 * i + 1] - lo[1]) * scale;
       // Cuts and links dark, air moves red: one path per colour.
-      for (const [which, colour, width] of [[(kk) => kk <= 1 || kk === 4, 0x1f3b73, 0.6], [(kk) => kk === 2 || kk === 3, 0xd62728, 0.8]]) {
+      for (const [which, colour, width] of [[(kk) => kk <= 1 || kk === 4, 0x1f3b73, 0.6], [(kk) => kk === 2 || kk === 3 || kk === 5, 0xd62728, 0.8]]) {
         ctx.strokeStyle = hexCss(colour);
         ctx.lineWidth = width;
         ctx.beginPath();

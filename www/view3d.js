@@ -527,6 +527,10 @@ export class View3D {
           }
           cam.position.copy(target).add(offset);
         }
+      } else if ((e.key === '+' || e.key === '=' || e.key === '-' || e.key === '_') && cam.isOrthographicCamera) {
+        // A parallel camera zooms; moving it closer changes nothing on screen.
+        cam.zoom *= e.key === '+' || e.key === '=' ? 1.15 : 1 / 1.15;
+        cam.updateProjectionMatrix();
       } else if (e.key === '+' || e.key === '=') {
         cam.position.copy(target).addScaledVector(offset, 1 / 1.15);
       } else if (e.key === '-' || e.key === '_') {

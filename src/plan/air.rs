@@ -143,12 +143,18 @@ pub fn route(
     opts: &PlanOptions,
     dist: &SurfaceDistance,
 ) -> Routed {
-    let bbox = model.surface.bbox();
+    // The model and its stock: escapes end outside both.
+    let (bbox, stock) = (model.surface.bbox(), model.stock);
     let grow = path.tool_radius_mm + opts.clearance_mm;
     let grown = Bounds {
-        lo: [0, 1, 2].map(|k| bbox.min[k] - grow),
-        hi: [0, 1, 2].map(|k| bbox.max[k] + grow),
+        lo: [0, 1, 2].map(|k| bbox.min[k].min(stock.min[k]) - grow),
+        hi: [0, 1, 2].map(|k| bbox.max[k].max(stock.max[k]) + grow),
     };
+    // Stock declared above the part may still be there: coming down, the tool feeds from
+    // the feed height above the stock's top (ball centre at this height), not only above
+    // the cut.
+    let feed_floor = (stock.max[2] > bbox.max[2])
+        .then(|| stock.max[2] + opts.feed_height_mm + path.tool_radius_mm);
     let sweep = Sweep {
         dist,
         rad: path.tool_radius_mm - opts.overcut_mm() + dist.tolerance_mm,
@@ -230,8 +236,9 @@ pub fn route(
             }
             Leg::Arriving => {
                 let down: Vec<Point3> = way.iter().rev().copied().collect();
-                let (rapid, fed) =
-                    split_at_feed_height(&down, &old.moves[*cut].cl_point, opts.feed_height_mm);
+                let at = old.moves[*cut].cl_point;
+                let below = feed_floor.map_or(0.0, |z| way_below(&down, &at, z));
+                let (rapid, fed) = split_at_feed_height(&down, &at, opts.feed_height_mm.max(below));
                 for p in rapid {
                     push(Move { cl_point: p, ..m });
                 }
@@ -246,6 +253,29 @@ pub fn route(
         }
     });
     Routed::Done(stats)
+}
+
+/// The length of the way down (`down`, then the cut at `cut`) below height `z` (mm): from
+/// where it first goes below `z` to the cut. 0 when the cut is above it; the whole way
+/// when it starts below it.
+fn way_below(down: &[Point3], cut: &Point3, z: f64) -> f64 {
+    let mut pts: Vec<Point3> = down.to_vec();
+    pts.push(*cut);
+    let mut below = 0.0;
+    // From the cut back up: the part of each leg below `z`.
+    for w in pts.windows(2).rev() {
+        let (hi, lo) = (w[0], w[1]);
+        let len = (hi - lo).norm();
+        if hi.z <= z {
+            below += len;
+            continue;
+        }
+        if lo.z < z {
+            below += len * (z - lo.z) / (hi.z - lo.z);
+        }
+        break;
+    }
+    below
 }
 
 /// Points closer than this are one point when the feed height falls on a corner of the
@@ -308,6 +338,19 @@ mod tests {
         let d = Vector3::new(1.0, 0.0, 1.0).normalize();
         let e = b.exit(&p, &d);
         assert!((e - Point3::new(3.0, 0.0, 4.0)).norm() < 1e-12, "{e}");
+    }
+
+    #[test]
+    fn the_way_below_a_height_is_measured_from_where_it_goes_below() {
+        let cut = Point3::new(0.0, 0.0, 0.0);
+        let safe = Point3::new(0.0, 0.0, 10.0);
+        assert!((way_below(&[safe], &cut, 4.0) - 4.0).abs() < 1e-12);
+        assert_eq!(way_below(&[safe], &cut, -1.0), 0.0);
+        assert!((way_below(&[safe], &cut, 12.0) - 10.0).abs() < 1e-12);
+        // Down to a lead-off point 0.1 mm aside, then across onto the cut.
+        let lead = Point3::new(0.1, 0.0, 0.0);
+        let up = Point3::new(0.1, 0.0, 10.0);
+        assert!((way_below(&[up, lead], &cut, 3.0) - 3.1).abs() < 1e-12);
     }
 
     #[test]

@@ -75,6 +75,9 @@ pub fn estimate(model: &Model, opts: &PlanOptions) -> WorkEstimate {
                         0.0
                     };
                     len[q] += speed / cells;
+                    if speed <= 0.0 {
+                        continue; // a collapsed side: no length, no steps
+                    }
                     per_side[q] += 1.0 / side(k) / cells;
                     per_chord[q] +=
                         1.0 / chord_step(chord, k).min(speed / MIN_STEPS_PER_PASS) / cells;
@@ -109,7 +112,8 @@ pub fn estimate(model: &Model, opts: &PlanOptions) -> WorkEstimate {
 pub fn check(model: &Model, opts: &PlanOptions) -> Result<WorkEstimate> {
     let e = estimate(model, opts);
     let limit = opts.max_cl_points as f64;
-    if e.cl_points <= limit {
+    // Within the limit, or no estimate to go by (not finite): plan.
+    if !(e.cl_points > limit && e.cl_points.is_finite()) {
         return Ok(e);
     }
     // The scallop that would bring it within the limit (the estimate falls as h grows).

@@ -121,12 +121,13 @@ pub struct DraftBuilder {
 
 impl DraftBuilder {
     /// An empty draft for `model` planned with `opts`: the safe plane is two tool radii
-    /// and the clearance above the model.
+    /// and the clearance above the model and its stock.
     pub fn new(model: &Model, opts: &PlanOptions) -> Self {
         let r = opts.tool_radius_mm;
+        let top = model.surface.bbox().max[2].max(model.stock.max[2]);
         DraftBuilder {
             r,
-            safe_z: model.surface.bbox().max[2] + 2.0 * r + opts.clearance_mm,
+            safe_z: top + 2.0 * r + opts.clearance_mm,
             moves: Vec::new(),
             params: Vec::new(),
             footprints: Vec::new(),

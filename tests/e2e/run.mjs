@@ -1533,6 +1533,15 @@ test('a saved job reopens in a fresh browser to the same plan: the same G-code b
   const st = await p2.locator(`${HOST} >> #status`).textContent();
   check(/names no model/.test(st), `the broken job is named with why: ${st}`);
   check(await p2.evaluate((h) => document.querySelector(h).dataset.state, HOST) === 'planned', 'the plan shown stays');
+  // A job whose model cannot be opened leaves the model and its parameters as they were.
+  const missing = JSON.stringify({ ...saved, model: { sample: 'nope' }, parameters: { ...saved.parameters, scallop: '0.09', 'work-offset': '59' } });
+  await p2.setInputFiles('#file', { name: 'missing.tspath-job.json', mimeType: 'application/json', buffer: Buffer.from(missing) });
+  await p2.waitForFunction((h) => /missing\.tspath-job\.json/.test(document.querySelector(h).shadowRoot.getElementById('status').textContent), HOST);
+  const kept = await p2.evaluate(() => ['scallop', 'work-offset'].map((k) => document.querySelector('tspath-planner').shadowRoot.getElementById(`p-${k}`).value));
+  const said = await p2.locator(`${HOST} >> #status`).textContent();
+  check(JSON.stringify(kept) === JSON.stringify(['0.04', '56']) && /nope/.test(said), `the parameters stay the model's (${kept}); “${said.slice(0, 100)}”`);
+  const g3 = (await downloadText(p2, '#download-gcode')).bytes.toString('utf8');
+  check(g3 === g, 'the program shown is still the job\'s');
   await other.close();
   return `job ${job.bytes.length} bytes; reopened in a fresh profile: G-code ${g2.length} bytes, equal; broken job: “${st.slice(0, 60)}…”`;
 });
@@ -1635,6 +1644,11 @@ test('viewer basics: standard views, orthographic camera, table grid; legends be
   await page.check('#ortho');
   const ortho = await host(page, (el) => ({ is: el.view.camera.isOrthographicCamera, drawn: el.countPixels().drawn }));
   check(ortho.is && ortho.drawn > 0.5 * persp && ortho.drawn < 2 * persp, `orthographic: ${JSON.stringify(ortho)} px (perspective ${persp} px)`);
+  // The keys zoom the parallel camera too.
+  await page.focus('#view');
+  await page.keyboard.press('+');
+  const zoom = await host(page, (el) => el.view.camera.zoom);
+  check(Math.abs(zoom - 1.15) < 1e-9, `+ zooms the orthographic camera: ${zoom}`);
   await page.click('#fit');
   const fitted = await host(page, (el) => el.countPixels().drawn);
   check(fitted > 1000, `fit in orthographic draws the model (${fitted} px)`);
