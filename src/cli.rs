@@ -330,15 +330,9 @@ const PLAN_SWITCHES: &[&str] = &[
     "--on-table",
 ];
 
-const PLAN_FLAGS: &[&str] = &[
+/// The plan's own flags (with a value); `plan` and `compare` take these and the set-up's.
+const PLAN_OWN_FLAGS: &[&str] = &[
     "--work-offset",
-    "--model-units",
-    "--scale",
-    "--up",
-    "--rotate",
-    "--stock-side",
-    "--stock-top",
-    "--zero",
     "--slice-angle",
     "--tool-radius",
     "--scallop",
@@ -491,7 +485,7 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
 }
 
 fn plan(args: &[String]) -> Result<(String, Status)> {
-    let a = parse(args, PLAN_FLAGS, PLAN_SWITCHES)?;
+    let a = parse(args, &[SETUP_FLAGS, PLAN_OWN_FLAGS].concat(), PLAN_SWITCHES)?;
     let (m, mach, opts) = plan_setup(&a)?;
     let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
     let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
@@ -548,7 +542,7 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
 fn compare_cmd(args: &[String]) -> Result<String> {
     let a = parse(
         args,
-        &[PLAN_FLAGS, &["--strategies", "--csv"]].concat(),
+        &[SETUP_FLAGS, PLAN_OWN_FLAGS, &["--strategies", "--csv"]].concat(),
         &[PLAN_SWITCHES, &["--no-verify"]].concat(),
     )?;
     if a.value("--strategy").is_some() || a.value("-o").is_some() {
@@ -592,21 +586,18 @@ fn verify_cmd(args: &[String]) -> Result<String> {
     let a = parse(
         args,
         &[
-            "--tool-radius",
-            "--samples",
-            "--bound",
-            "--scallop",
-            "--gouge-tolerance",
-            "--machine",
-            "--dialect",
-            "--model-units",
-            "--scale",
-            "--up",
-            "--rotate",
-            "--stock-side",
-            "--stock-top",
-            "--zero",
-        ],
+            SETUP_FLAGS,
+            &[
+                "--tool-radius",
+                "--samples",
+                "--bound",
+                "--scallop",
+                "--gouge-tolerance",
+                "--machine",
+                "--dialect",
+            ],
+        ]
+        .concat(),
         SETUP_SWITCHES,
     )?;
     let [model, path_file] = a.positional[..] else {

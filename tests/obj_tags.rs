@@ -2,6 +2,9 @@
 //! with `t crease` tags loads with a warning naming the tag and its line, every plan of it
 //! lists that among its problems (the CLI exits 3), and an unknown tag is refused naming it.
 
+mod support;
+
+use support::extruded_obj;
 use tspath::io;
 use tspath::model::samples;
 use tspath::plan::{self, PlanOptions, PlanStatus};
@@ -9,27 +12,11 @@ use tspath::plan::{self, PlanOptions, PlanStatus};
 /// A wavy sheet cage (quads) with two crease tags and a corner tag, as subdivision tools
 /// write them.
 fn tagged_sheet() -> String {
-    let (nx, ny) = (6, 4);
-    let mut s = String::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            s += &format!("v {} {} {}\n", 5 * i, 6 * j, (0.8 * i as f64).sin() * 2.0);
-        }
-    }
-    for j in 0..ny - 1 {
-        for i in 0..nx - 1 {
-            let id = |a: usize, b: usize| b * nx + a + 1;
-            s += &format!(
-                "f {} {} {} {}\n",
-                id(i, j),
-                id(i + 1, j),
-                id(i + 1, j + 1),
-                id(i, j + 1)
-            );
-        }
-    }
-    s += "t crease 2/1/0 7 8 2.0\nt crease 2/1/0 8 9 2.0\nt corner 1/1/0 0 10.0\n";
-    s
+    let profile: Vec<(f64, f64)> = (0..6)
+        .map(|i| (5.0 * i as f64, 2.0 * (0.8 * i as f64).sin()))
+        .collect();
+    extruded_obj(&profile, 3, 6.0, false)
+        + "t crease 2/1/0 7 8 2.0\nt crease 2/1/0 8 9 2.0\nt corner 1/1/0 0 10.0\n"
 }
 
 #[test]
