@@ -7,7 +7,7 @@
 //! Owns: the estimate and the refusal. Must not: plan (it reads the surface, nothing else).
 
 use super::isoparametric::{CHORD_MARGIN, CHORD_SCALLOP_SHARE};
-use super::stepover::chord_step;
+use super::stepover::{chord_step, curve_curvature};
 use super::{PlanOptions, Strategy};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -39,6 +39,47 @@ pub struct WorkEstimate {
 /// the curvature of its middle (at least [`MIN_STEPS_PER_PASS`]); the space-filling curve's
 /// grid is scallop-limited both ways (area over the side step squared).
 pub fn estimate(model: &Model, opts: &PlanOptions) -> WorkEstimate {
+    estimate_from(&sample(model), opts)
+}
+
+/// What the estimate needs of a patch, sampled once (it does not depend on the settings):
+/// its area and, per sample, the speed (mm per unit parameter) and curvature (1/mm) of the
+/// u and v curves.
+struct PatchSamples {
+    area_mm2: f64,
+    /// Per sample, `[(speed, curvature) along u, (speed, curvature) along v]`.
+    curves: Vec<[(f64, f64); 2]>,
+}
+
+/// Every patch of `model` at `AREA_SAMPLES` × `AREA_SAMPLES` points.
+fn sample(model: &Model) -> Vec<PatchSamples> {
+    let n = AREA_SAMPLES;
+    let cells = (n * n) as f64;
+    model
+        .layout
+        .patches
+        .iter()
+        .map(|p| {
+            let mut area_mm2 = 0.0;
+            let mut curves = Vec::with_capacity(n * n);
+            for i in 0..n {
+                for j in 0..n {
+                    let (u, v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+                    let d = p.derivs(&model.surface, u, v);
+                    area_mm2 += d.su.cross(&d.sv).norm() / cells;
+                    curves.push([
+                        (d.su.norm(), curve_curvature(&d.su, &d.suu)),
+                        (d.sv.norm(), curve_curvature(&d.sv, &d.svv)),
+                    ]);
+                }
+            }
+            PatchSamples { area_mm2, curves }
+        })
+        .collect()
+}
+
+/// [`estimate`] from the patches' samples.
+fn estimate_from(patches: &[PatchSamples], opts: &PlanOptions) -> WorkEstimate {
     let r = opts.tool_radius_mm;
     // The planners' share of the scallop for the side steps, and their chord tolerance.
     let h_target = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
@@ -51,41 +92,28 @@ pub fn estimate(model: &Model, opts: &PlanOptions) -> WorkEstimate {
             .chordal_mm
             .min(opts.overcut_mm())
             .min(CHORD_SCALLOP_SHARE * opts.scallop_mm);
-    let n = AREA_SAMPLES;
-    let cells = (n * n) as f64;
     let mut points = 0.0;
     let mut area = 0.0;
-    for p in &model.layout.patches {
-        // Means over the samples: area, side lengths, steps per mm along and across u, v;
-        // the largest curvatures (the space-filling curve's lines take the least step along
-        // the whole line).
-        let (mut a, mut len) = (0.0, [0.0; 2]);
+    for p in patches {
+        // Means over the samples: side lengths, steps per mm along and across u, v; the
+        // largest curvatures (the space-filling curve's lines take the least step along the
+        // whole line).
+        let cells = p.curves.len() as f64;
+        let mut len = [0.0; 2];
         let (mut per_side, mut per_chord) = ([0.0; 2], [0.0; 2]);
         let mut k_max: [f64; 2] = [0.0; 2];
-        for i in 0..n {
-            for j in 0..n {
-                let (u, v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
-                let d = p.derivs(&model.surface, u, v);
-                a += d.su.cross(&d.sv).norm() / cells;
-                for (q, (c1, c2)) in [(d.su, d.suu), (d.sv, d.svv)].iter().enumerate() {
-                    let speed = c1.norm();
-                    let k = if speed > 0.0 {
-                        c1.cross(c2).norm() / (speed * speed * speed)
-                    } else {
-                        0.0
-                    };
-                    len[q] += speed / cells;
-                    if speed <= 0.0 {
-                        continue; // a collapsed side: no length, no steps
-                    }
-                    per_side[q] += 1.0 / side(k) / cells;
-                    per_chord[q] +=
-                        1.0 / chord_step(chord, k).min(speed / MIN_STEPS_PER_PASS) / cells;
-                    k_max[q] = k_max[q].max(k);
+        for sample in &p.curves {
+            for (q, &(speed, k)) in sample.iter().enumerate() {
+                len[q] += speed / cells;
+                if speed <= 0.0 {
+                    continue; // a collapsed side: no length, no steps
                 }
+                per_side[q] += 1.0 / side(k) / cells;
+                per_chord[q] += 1.0 / chord_step(chord, k).min(speed / MIN_STEPS_PER_PASS) / cells;
+                k_max[q] = k_max[q].max(k);
             }
         }
-        area += a;
+        area += p.area_mm2;
         points += match opts.strategy {
             // Lines stepped across each direction at the least step along them.
             Strategy::Isfc => {
@@ -110,14 +138,16 @@ pub fn estimate(model: &Model, opts: &PlanOptions) -> WorkEstimate {
 /// Refuses settings whose estimate is beyond `opts.max_cl_points`, naming the estimate,
 /// the limit and what to change.
 pub fn check(model: &Model, opts: &PlanOptions) -> Result<WorkEstimate> {
-    let e = estimate(model, opts);
+    let patches = sample(model);
+    let e = estimate_from(&patches, opts);
     let limit = opts.max_cl_points as f64;
     // Within the limit, or no estimate to go by (not finite): plan.
     if !(e.cl_points > limit && e.cl_points.is_finite()) {
         return Ok(e);
     }
     // The scallop that would bring it within the limit (the estimate falls as h grows).
-    let fits = |h: f64| estimate(model, &opts.clone().with_scallop(h)).cl_points <= limit;
+    // The surface is sampled once; only the settings change.
+    let fits = |h: f64| estimate_from(&patches, &opts.clone().with_scallop(h)).cl_points <= limit;
     let largest = opts.tool_radius_mm;
     let advice = if fits(largest) {
         let (mut lo, mut hi) = (opts.scallop_mm.ln(), largest.ln());

@@ -456,11 +456,7 @@ pub fn forward_steps(
             FeedDir::AlongV => (d.sv, d.svv),
         };
         let speed = c1.norm();
-        let k = if speed > 0.0 {
-            c1.cross(&c2).norm() / (speed * speed * speed)
-        } else {
-            0.0
-        };
+        let k = stepover::curve_curvature(&c1, &c2);
         // Bound the curvature of the ball-centre curve too (radius shrinks by r on concave).
         let k_cl = if k * r < 0.5 {
             k / (1.0 - k * r)

@@ -3,6 +3,7 @@
 //! tolerance.
 
 use crate::error::{Error, Result};
+use crate::geom::Vector3;
 use crate::surface::DiffGeom;
 
 /// Which parameter the cutting moves run along.
@@ -78,6 +79,17 @@ pub fn physical_side_step(dg: &DiffGeom, dir: FeedDir, dparam: f64) -> f64 {
     match dir {
         FeedDir::AlongU => dparam * det / dg.e.sqrt(),
         FeedDir::AlongV => dparam * det / dg.g.sqrt(),
+    }
+}
+
+/// Curvature (1/mm) of a curve with first and second derivatives `c1`, `c2`:
+/// `|c1 × c2| / |c1|³`; 0 where the curve stops (`c1` nil).
+pub fn curve_curvature(c1: &Vector3, c2: &Vector3) -> f64 {
+    let speed = c1.norm();
+    if speed > 0.0 {
+        c1.cross(c2).norm() / (speed * speed * speed)
+    } else {
+        0.0
     }
 }
 
