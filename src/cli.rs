@@ -20,6 +20,7 @@ const USAGE: &str = "usage:
               [--plunge-feed MM_PER_MIN] [--clearance MM] [--feed-height MM]
               [--max-cl-points N]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
+              [--max-axis-step DEG]
               [--axis-preset vertical|gan2014|yuan2012]
               [--shank MM] [--shank-length MM] [--holder MM] [--holder-length MM]
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
@@ -56,6 +57,8 @@ down to --feed-height above each cut (default 2 mm, along its way down) and goes
 --plunge-feed (default 300 mm/min).
 --max-cl-points (default 2 000 000) refuses, before planning, settings whose estimated CL
 points exceed it, naming the estimate and the scallop that would fit.
+--max-axis-step (default 5°) is the largest turn of the tool axis from one cut point to
+the next (five-axis): larger turns are spread over the points around them, else split.
 --axis-preset gan2014 leads the tool 10° from the surface normal along the feed, as the
 space-filling-curve paper machined (five-axis machines); --lead/--tilt after it override.
 --machine is a built-in machine (default 3-axis) or a machine JSON file (start from
@@ -358,6 +361,7 @@ const PLAN_OWN_FLAGS: &[&str] = &[
     "--holder",
     "--holder-length",
     "--max-tilt",
+    "--max-axis-step",
     "--strategy",
     "--axis-preset",
 ];
@@ -381,6 +385,7 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
         ("--plunge-feed", &mut opts.plunge_feed_mm_min),
         ("--clearance", &mut opts.clearance_mm),
         ("--feed-height", &mut opts.feed_height_mm),
+        ("--max-axis-step", &mut opts.max_axis_step_deg),
     ] {
         if let Some(v) = a.number(flag)? {
             *slot = v;

@@ -44,6 +44,7 @@ export const PARAMS = [
   { key: 'max-cl-points', field: 'max_cl_points', group: 'accuracy', label: 'Most CL points (estimated before planning; more is refused)', unit: 'points', kind: 'number', min: 1000, max: 100000000, step: 100000, default: 2000000, integer: true },
   // Tool axis (five-axis machines only)
   { key: 'max-tilt', field: 'max_tilt_deg', group: 'axis', label: 'Largest tilt to clear the holder', unit: '°', kind: 'number', min: 0, max: 135, step: 1, default: 60, fiveAxis: true },
+  { key: 'max-axis-step', field: 'max_axis_step_deg', group: 'axis', label: 'Largest axis turn between cut points', unit: '°', kind: 'number', min: 0.5, max: 45, step: 0.5, default: 5, fiveAxis: true },
   { key: 'lead', field: 'lead_deg', group: 'axis', label: 'Lead angle', unit: '°', kind: 'number', min: -79, max: 79, step: 1, default: 0, fiveAxis: true },
   { key: 'tilt', field: 'tilt_deg', group: 'axis', label: 'Tilt angle', unit: '°', kind: 'number', min: -79, max: 79, step: 1, default: 0, fiveAxis: true },
   // Order

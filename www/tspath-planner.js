@@ -318,7 +318,8 @@ const STATS = [
     if (!v) return '…';
     return v.samples === x.samples ? int(v.samples) : `${int(v.samples)} (grown from ${int(x.samples)})`;
   }],
-  ['max_axis_step_deg', 'Largest tool-axis step', (r) => deg(r.max_axis_step_deg)],
+  ['max_axis_step_deg', 'Largest tool-axis turn between cut points', (r) => deg(r.max_axis_step_deg)],
+  ['max_axis_acceleration_deg_s2', 'Largest tool-axis acceleration at the feed', (r) => `${int(r.max_axis_acceleration_deg_s2)} °/s²`],
   ['machining_time_min', 'Machining time', (r) => minutes(r.machining_time_min)],
   ['feed_time_min', 'Length ÷ feed (no acceleration)', (r) => minutes(r.feed_time_min)],
   ['plan_ms', 'Planning time', (r) => ms(r.plan_ms)],

@@ -33,7 +33,7 @@ const MIN_AXIS_NORMAL_COS: f64 = 0.035;
 
 /// True if `axis` comes from the side the surface faces at the contact (unit normal `n`)
 /// and the shank and holder along it at ball centre `c` are clear.
-fn usable(
+pub(super) fn usable(
     obs: &Clearance,
     (c, n): (&Point3, &Vector3),
     axis: &Vector3,
@@ -57,7 +57,7 @@ fn vertical_hit(
 }
 
 /// Unit contact normal of a move (from the contact point to the ball centre).
-fn contact_normal(m: &Move) -> Vector3 {
+pub(super) fn contact_normal(m: &Move) -> Vector3 {
     (m.cl_point - m.cc_point)
         .try_normalize(AXIS_MIN_NORM)
         .unwrap_or_else(Vector3::z)
@@ -449,7 +449,7 @@ const OBSTACLE_SAMPLES: f64 = 150.0;
 const GRID_CELLS: f64 = 64.0;
 
 /// Unit axis tilted `theta` (radians) from +Z towards azimuth `phi`.
-fn tilted(theta: f64, phi: f64) -> Vector3 {
+pub(super) fn tilted(theta: f64, phi: f64) -> Vector3 {
     Vector3::new(
         theta.sin() * phi.cos(),
         theta.sin() * phi.sin(),
@@ -462,7 +462,7 @@ fn tilted(theta: f64, phi: f64) -> Vector3 {
 /// bisection. With a `hint` (the previous point's tilt: it changes little from point to
 /// point) the coarse steps start there, going down while clear or up while not, so that
 /// a clear tilt costs a few tests instead of a scan from zero.
-fn least_tilt(
+pub(super) fn least_tilt(
     obs: &Clearance,
     (c, n): (&Point3, &Vector3),
     opts: &PlanOptions,
@@ -581,7 +581,8 @@ pub struct AxisStats {
     pub facing_away: usize,
     /// The first of those, for the report.
     pub first_blocked: Option<Point3>,
-    /// Moves between two cut points whose axis turn was split into smaller clear turns.
+    /// Moves between two cut points whose axis turn was split into smaller clear turns
+    /// (where it was blocked or larger than `max_axis_step_deg`).
     pub bridged: usize,
     /// Moves between two cut points during which the turning tool's shank or holder
     /// still comes within the safety margin of the model (poses checked every
@@ -592,6 +593,9 @@ pub struct AxisStats {
     pub margin_mm: f64,
     /// The end of the first of those (ball centre, mm).
     pub first_sweep_hit: Option<Point3>,
+    /// Windows of cut points whose axes were re-chosen along the pass to spread a large
+    /// turn (see [`super::smooth`]).
+    pub spread: usize,
 }
 
 /// Turn of the tool axis between the poses checked while it turns from one cut point to
@@ -601,7 +605,7 @@ const SWEEP_STEP_DEG: f64 = 2.0;
 /// True if a pose between cut points `a` and `b` (ball centre and axis interpolated
 /// linearly, every [`SWEEP_STEP_DEG`] of turn and at most the samples' gap of travel apart)
 /// puts the shank or holder into the model.
-fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool {
+pub(super) fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool {
     let step = SWEEP_STEP_DEG.to_radians();
     let turn = a.tool_axis.angle(&b.tool_axis);
     let travel = (b.cl_point - a.cl_point).norm();
@@ -628,9 +632,11 @@ fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool
 const BRIDGE_DEPTH: usize = 6;
 
 /// Appends to `out` cut points between `a` and `b` (at fractions of the way from `s0` to
-/// `s1`) that split a blocked turn into clear ones: the midpoint of the chord with +Z if
-/// that is clear, else the interpolated axis if clear, else the least tilt leaning from
-/// `a`'s; then each half likewise. False if some turn stays blocked.
+/// `s1`) that split a blocked turn into clear ones, or a turn larger than
+/// `max_axis_step_deg` into smaller ones: the midpoint of the chord with the halfway axis
+/// for a clear turn; for a blocked one, +Z if that is clear, else the halfway axis if
+/// clear, else the least tilt leaning from `a`'s; then each half likewise. False if some
+/// turn stays blocked.
 #[allow(clippy::too_many_arguments)]
 fn bridge(
     a: &Move,
@@ -641,23 +647,29 @@ fn bridge(
     depth: usize,
     out: &mut Vec<(Move, f64)>,
 ) -> bool {
-    if !turn_blocked(a, b, obs, opts) {
+    let blocked = turn_blocked(a, b, obs, opts);
+    let large = a.tool_axis.angle(&b.tool_axis) > opts.max_axis_step_deg.to_radians();
+    if !blocked && !large {
         return true;
     }
     if depth == 0 {
-        return false;
+        return !blocked;
     }
     let cl = Point3::from((a.cl_point.coords + b.cl_point.coords) * 0.5);
     let cc = Point3::from((a.cc_point.coords + b.cc_point.coords) * 0.5);
     let n = (contact_normal(a) + contact_normal(b))
         .try_normalize(AXIS_MIN_NORM)
         .unwrap_or_else(|| contact_normal(b));
-    let axis = match vertical_hit(obs, (&cl, &n), &cc, opts) {
-        None => Some(Vector3::z()),
-        Some(h) => (a.tool_axis + b.tool_axis)
-            .try_normalize(AXIS_MIN_NORM)
-            .filter(|x| usable(obs, (&cl, &n), x, opts))
-            .or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
+    let halfway = (a.tool_axis + b.tool_axis)
+        .try_normalize(AXIS_MIN_NORM)
+        .filter(|x| within_tilt(x, opts) && usable(obs, (&cl, &n), x, opts));
+    // A clear turn that is only too large is halved along its way.
+    let axis = match (blocked, halfway) {
+        (false, Some(x)) => Some(x),
+        _ => match vertical_hit(obs, (&cl, &n), &cc, opts) {
+            None => Some(Vector3::z()),
+            Some(h) => halfway.or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
+        },
     };
     let Some(axis) = axis else {
         return false;
@@ -728,7 +740,7 @@ fn any_tangent(n: &Vector3) -> Vector3 {
 }
 
 /// Whether unit axis `a` leans from +Z by no more than the largest tilt allowed.
-fn within_tilt(a: &Vector3, opts: &PlanOptions) -> bool {
+pub(super) fn within_tilt(a: &Vector3, opts: &PlanOptions) -> bool {
     a.z >= opts.max_tilt_deg.max(0.0).to_radians().cos()
 }
 

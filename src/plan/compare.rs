@@ -143,7 +143,7 @@ pub struct StrategyRun {
     pub retractions: usize,
     pub reversals: usize,
     pub cl_points: usize,
-    /// Largest change of the tool axis between consecutive CL points (degrees).
+    /// Largest turn of the tool axis between consecutive cut points while cutting (degrees).
     pub max_axis_step_deg: f64,
     pub plan_ms: f64,
     /// On the machine named in [`Comparison::machine`] or the plan's default machine.

@@ -19,6 +19,7 @@ pub mod options;
 pub mod order;
 pub mod pipeline;
 pub mod reach;
+pub mod smooth;
 pub mod stepover;
 pub mod toolpath;
 pub mod watershed;

@@ -10,6 +10,11 @@ use serde::{Deserialize, Serialize};
 /// machining tests (degrees).
 pub const PAPER_LEAD_DEG: f64 = 10.0;
 
+/// Range of the largest axis step between cut points (degrees): below 0.5° the poses in
+/// between multiply past use; above 45° the tool between two points is far from both.
+pub const MIN_AXIS_STEP_DEG: f64 = 0.5;
+pub const MAX_AXIS_STEP_DEG: f64 = 45.0;
+
 /// What the planner is asked for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -70,6 +75,11 @@ pub struct PlanOptions {
     /// Largest tilt of the tool axis from +Z the planner may use to clear the shank and
     /// holder (degrees). Default 60°; 0° plans three-axis (the axis stays +Z).
     pub max_tilt_deg: f64,
+    /// Largest turn of the tool axis from one cut point to the next (degrees): larger
+    /// turns are first spread over the points around them, then split by poses in
+    /// between. Default 5°: the machine interpolates its rotary axes linearly between
+    /// points, so the tool between them stays close to the poses checked for clearance.
+    pub max_axis_step_deg: f64,
     /// Which strategy decides what to cut. Default `isoparametric` (patch-ordered zig-zags,
     /// Shang et al. 2020); `isfc`: one closed space-filling curve over the whole surface
     /// (Gan et al. 2014).
@@ -184,6 +194,7 @@ impl Default for PlanOptions {
             holder_radius_mm: 10.0,
             holder_length_mm: 40.0,
             max_tilt_deg: 60.0,
+            max_axis_step_deg: 5.0,
             strategy: Strategy::Isoparametric,
             isfc_plain: false,
             isfc_length_weight: 1.0,
@@ -354,6 +365,18 @@ impl PlanOptions {
                     format!("must be between -80° and 80°, got {v}"),
                 ));
             }
+        }
+        if !(self.max_axis_step_deg.is_finite()
+            && (MIN_AXIS_STEP_DEG..=MAX_AXIS_STEP_DEG).contains(&self.max_axis_step_deg))
+        {
+            return Err(Error::param(
+                "max_axis_step_deg",
+                format!(
+                    "must be from {MIN_AXIS_STEP_DEG}° to {MAX_AXIS_STEP_DEG}° (the largest \
+                     turn of the tool axis between two cut points), got {}°",
+                    self.max_axis_step_deg
+                ),
+            ));
         }
         if !(self.max_tilt_deg.is_finite() && (0.0..=MAX_TILT_DEG).contains(&self.max_tilt_deg)) {
             return Err(Error::param(

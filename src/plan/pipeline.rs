@@ -18,6 +18,7 @@ use super::distance::SurfaceDistance;
 use super::draft::{Draft, Footprint};
 use super::gouge::{self, GougeStats};
 use super::reach::{self, Rest, Why};
+use super::smooth;
 use super::toolpath::{PlanReport, PlanStatus, Problem, Toolpath};
 use super::PlanOptions;
 use crate::error::{Error, Result};
@@ -144,6 +145,9 @@ pub fn finish(
     let (mut axes, mut why) = axis::choose(&obs, &mut draft.toolpath, opts, &mut |f| {
         progress(0.3 + 0.5 * f)
     })?;
+    // Large turns between neighbouring cut points spread over the points around them.
+    let spread = smooth::spread_turns(&obs, &mut draft.toolpath, opts, &why);
+    axes.spread = spread.smoothed;
     // 3. Split the cuts there and route the air moves; where the ball cannot get to a cut or
     //    away from it, leave those points out too and split again.
     let dist = SurfaceDistance::new(model, (AIR_TESSELLATION_SHARE * r).max(opts.overcut_mm()));

@@ -107,6 +107,33 @@ impl OldMoves<'_> {
     }
 }
 
+/// Interval at which the tool axis is sampled in time for its angular acceleration (s).
+pub const ACCELERATION_SAMPLE_S: f64 = 0.05;
+
+/// The axis at time `t` of a run of `(time, axis)` points (times increasing), turning at a
+/// constant rate between them.
+fn axis_at(run: &[(f64, Vector3)], t: f64) -> Vector3 {
+    let k = run.partition_point(|&(s, _)| s <= t);
+    if k == 0 {
+        return run[0].1;
+    }
+    if k == run.len() {
+        return run[k - 1].1;
+    }
+    let ((s0, u), (s1, v)) = (run[k - 1], run[k]);
+    let f = (t - s0) / (s1 - s0);
+    let angle = u.angle(&v);
+    if angle < 1e-12 {
+        return u;
+    }
+    let sin = angle.sin();
+    if sin < 1e-12 {
+        // Opposite axes: no defined way round; the nearer end.
+        return if f < 0.5 { u } else { v };
+    }
+    u * (((1.0 - f) * angle).sin() / sin) + v * ((f * angle).sin() / sin)
+}
+
 /// Summary of a tool path (keys as in the JSON report).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlanReport {
@@ -120,7 +147,15 @@ pub struct PlanReport {
     pub cl_points: usize,
     pub patches: usize,
     pub max_predicted_scallop_mm: f64,
+    /// Largest turn of the tool axis from one cut point to the next while cutting (moves
+    /// from a point on the surface to a cutting or linking one), degrees.
     pub max_axis_step_deg: f64,
+    /// Largest angular acceleration of the tool axis while cutting (deg/s²), each move
+    /// lasting its travel at the cutting feed or its turn at the fastest rotary feed of the
+    /// machine timed (`time_machine`), whichever is longer; see
+    /// [`Toolpath::max_axis_acceleration`].
+    #[serde(default)]
+    pub max_axis_acceleration_deg_s2: f64,
     /// The patches in the order cut, with their corners and passes.
     pub patch_order: Vec<PatchRun>,
     /// Things the user should know (retractions the layout forced, ...).
@@ -249,6 +284,8 @@ impl PlanReport {
         opts: &super::PlanOptions,
         machine: &crate::machine::Machine,
     ) {
+        self.max_axis_acceleration_deg_s2 =
+            path.max_axis_acceleration(opts.feed_mm_min, machine.max_rotary_feed_deg_min);
         let t = crate::machine::path_times(path, opts, machine);
         self.machining_time_min = t.total_min();
         self.time_machine = machine.name.clone();
@@ -316,6 +353,60 @@ impl Toolpath {
         }
     }
 
+    /// Largest angular acceleration of the tool axis while cutting (deg/s²): along each run
+    /// of cutting moves, each lasting its travel at `feed_mm_min` or its turn at
+    /// `rotary_feed_deg_min` (the machine's fastest rotary feed), whichever is longer, the
+    /// axis is sampled every [`ACCELERATION_SAMPLE_S`] and the change of its angular
+    /// velocity between samples taken over that time (so a jump in turning rate counts as
+    /// spread over one sample interval, as a machine's servo ramps it).
+    pub fn max_axis_acceleration(&self, feed_mm_min: f64, rotary_feed_deg_min: f64) -> f64 {
+        let dt = ACCELERATION_SAMPLE_S;
+        let mut largest: f64 = 0.0;
+        // Axes of the current run at uniform times: (time, axis) of its points.
+        let mut run: Vec<(f64, Vector3)> = Vec::new();
+        let mut finish = |run: &mut Vec<(f64, Vector3)>| {
+            let Some(&(end, _)) = run.last() else {
+                return;
+            };
+            let samples: Vec<Vector3> = (0..=(end / dt).floor() as usize)
+                .map(|k| axis_at(run, k as f64 * dt))
+                .collect();
+            let velocity = |u: &Vector3, v: &Vector3| {
+                u.cross(v)
+                    .try_normalize(f64::MIN_POSITIVE)
+                    .map_or(Vector3::zeros(), |k| k * (u.angle(v).to_degrees() / dt))
+            };
+            for w in samples.windows(3) {
+                let a = (velocity(&w[1], &w[2]) - velocity(&w[0], &w[1])).norm() / dt;
+                largest = largest.max(a);
+            }
+            run.clear();
+        };
+        for i in 1..self.moves.len() {
+            let (a, b) = (&self.moves[i - 1], &self.moves[i]);
+            if !(a.kind.on_surface() && matches!(b.kind, MoveKind::Feed | MoveKind::Link)) {
+                finish(&mut run);
+                continue;
+            }
+            let turn = a.tool_axis.angle(&b.tool_axis).to_degrees();
+            let took = ((b.cl_point - a.cl_point).norm() / feed_mm_min)
+                .max(turn / rotary_feed_deg_min)
+                * 60.0;
+            let t0 = match run.last() {
+                Some(&(t, _)) => t,
+                None => {
+                    run.push((0.0, a.tool_axis));
+                    0.0
+                }
+            };
+            if took > 0.0 {
+                run.push((t0 + took, b.tool_axis));
+            }
+        }
+        finish(&mut run);
+        largest
+    }
+
     /// Lengths, counts and time estimate. `feed` and `plunge_feed` in mm/min.
     pub fn report(&self, strategy: &str, feed: f64, plunge_feed: f64) -> PlanReport {
         let mut r = PlanReport {
@@ -330,6 +421,7 @@ impl Toolpath {
             patches: 0,
             max_predicted_scallop_mm: self.max_predicted_scallop_mm,
             max_axis_step_deg: 0.0,
+            max_axis_acceleration_deg_s2: 0.0,
             patch_order: self.runs.clone(),
             notes: Vec::new(),
             machining_time_min: 0.0,
@@ -390,8 +482,10 @@ impl Toolpath {
                 MoveKind::Retract | MoveKind::Rapid => last_dir = None,
                 _ => {}
             }
-            let cos = a.tool_axis.dot(&b.tool_axis).clamp(-1.0, 1.0);
-            r.max_axis_step_deg = r.max_axis_step_deg.max(cos.acos().to_degrees());
+            if a.kind.on_surface() && matches!(b.kind, MoveKind::Feed | MoveKind::Link) {
+                let turn = a.tool_axis.angle(&b.tool_axis).to_degrees();
+                r.max_axis_step_deg = r.max_axis_step_deg.max(turn);
+            }
         }
         // Retractions between cuts; the final one, after the last cut, does not count.
         let last_cut = self.moves.iter().rposition(|m| m.kind == MoveKind::Feed);
