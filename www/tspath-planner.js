@@ -27,6 +27,9 @@ import { GROUPS, PARAMS, byKey, flagOn, placement, planOptions, validate } from 
 const AUTO_REPLAN_MS = 1500;
 /** Pause after the last change before an automatic re-plan (ms). */
 const REPLAN_DELAY_MS = 300;
+/** Samples of the preview heat map shown while the simulation runs (at most a quarter of the
+ * simulation's start). */
+const PREVIEW_SAMPLES = 100000;
 /** G-code lines shown around the current one. */
 const LISTING_LINES = 13;
 /** Values longer than this (characters) go on their own line under their label, per list
@@ -1697,16 +1700,37 @@ export class TspathPlanner extends HTMLElement {
     this.$('cancel').disabled = false;
     this.$('colour-heat').disabled = true;
     plan.verification = null;
+    plan.preview = null;
+    delete this.dataset.preview;
     plan.report = plan.planReport;
     this.dataset.status = plan.report.status;
     this.#showStats();
     this.#showColours();
     if (!(await this.#ensureWorkerPlan())) return;
     const start = values.samples;
+    // A coarse heat map first, a tenth of the work or less, shown while the simulation that
+    // proves the scallop runs.
+    const preview = Math.min(PREVIEW_SAMPLES, Math.floor(start / 4));
+    if (preview >= byKey.samples.min) {
+      if (!this.$('status').classList.contains('error')) this.#planStatus(` Simulating a preview of the cut from ${int(preview)} samples…`);
+      try {
+        const p = await this.client.call('verify', [{ samples: preview }]);
+        if (token !== this.verifyToken || plan !== this.plan) return;
+        plan.preview = { heat: p.heat, summary: p.summary, samples: preview };
+        this.dataset.preview = 'shown';
+        this.$('colour-heat').disabled = false;
+        this.#showColours();
+      } catch (e) {
+        if (token !== this.verifyToken || e instanceof CancelledError) return;
+        // The full simulation below reports what went wrong.
+      }
+    }
     const bound = plan.options.scallop_mm * VERIFY_BOUND_SHARE;
     const cap = values['max-samples'];
     const what = ` Simulating the cut (from ${int(start)} samples until its error bound is ${mm(bound, 4)}, at most ${int(cap)} samples)…`;
-    this.#planStatus(what);
+    // An error shown meanwhile (a value typed during the preview) stays until the user acts.
+    const erring = () => this.$('status').classList.contains('error');
+    if (!erring()) this.#planStatus(what);
     const bar = this.$('progress');
     const t0 = performance.now();
     const done = () => {
@@ -1718,13 +1742,15 @@ export class TspathPlanner extends HTMLElement {
         bar.hidden = false;
         bar.value = f;
         // Progress, unless an error is being shown (it stays until the user acts).
-        if (!this.$('status').classList.contains('error')) {
+        if (!erring()) {
           this.#planStatus(`${what} ${Math.round(100 * f)} % (${((performance.now() - t0) / 1000).toFixed(1)} s)`);
         }
       });
       done();
       if (token !== this.verifyToken || plan !== this.plan) return;
       plan.verification = { ...v, samples: start };
+      plan.preview = null;
+      delete this.dataset.preview;
       plan.report = v.report;
       this.dataset.status = v.report.status;
       this.dataset.verify = 'done';
@@ -1734,6 +1760,13 @@ export class TspathPlanner extends HTMLElement {
       if (!this.hasAttribute('data-stale') && !this.$('status').classList.contains('error')) this.#planStatus();
     } catch (e) {
       done();
+      if (token === this.verifyToken && plan === this.plan && plan.preview) {
+        // The preview stood for a simulation that no longer runs.
+        plan.preview = null;
+        delete this.dataset.preview;
+        this.$('colour-heat').disabled = true;
+        this.#showColours();
+      }
       if (token !== this.verifyToken || e instanceof CancelledError) return;
       this.dataset.verify = 'error';
       this.#status(`The cutting simulation failed: ${e.message}`, true);
@@ -1991,7 +2024,9 @@ export class TspathPlanner extends HTMLElement {
   // ---------------------------------------------------------------- view
 
   #showColours() {
-    const heat = !!(this.$('colour-heat').checked && this.plan && this.plan.verification);
+    // The simulation's heat map, or its preview while it runs.
+    const shown = this.plan && (this.plan.verification || this.plan.preview);
+    const heat = !!(this.$('colour-heat').checked && shown);
     // The path would hide the heat map: off while the map shows, back as it was after.
     if (heat !== !!this.heatShown) {
       const box = this.$('layer-path');
@@ -2005,15 +2040,17 @@ export class TspathPlanner extends HTMLElement {
       this.heatShown = heat;
     }
     if (heat) {
-      this.view.setHeat(this.plan.verification.heat, this.plan.verification.summary.requested_scallop_mm);
-      this.#heatLegend(this.plan.verification.summary.requested_scallop_mm);
+      this.view.setHeat(shown.heat, shown.summary.requested_scallop_mm);
+      this.#heatLegend(shown.summary.requested_scallop_mm, this.plan.verification ? null : shown.samples);
     } else {
       this.view.setHeat(null);
       this.$('heat-legend').hidden = true;
     }
   }
 
-  #heatLegend(h) {
+  /** The heat map's legend for scallop `h` (mm); `preview`: the sample count of a preview
+   * shown while the simulation runs. */
+  #heatLegend(h, preview = null) {
     const el = this.$('heat-legend');
     const stops = [0, 0.25, 0.5, 0.75, 1].map((t) => hexCss(heatColour(t * h, h)));
     el.innerHTML = '';
@@ -2033,6 +2070,12 @@ export class TspathPlanner extends HTMLElement {
       keys.append(s);
     }
     el.append(bar, scale, keys);
+    if (preview) {
+      const note = document.createElement('div');
+      note.id = 'heat-preview';
+      note.textContent = `Preview from ${int(preview)} samples: the simulation that proves the scallop is still running.`;
+      el.append(note);
+    }
     el.hidden = false;
   }
 

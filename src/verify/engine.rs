@@ -303,12 +303,16 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
 }
 
 /// The overcut at a point of the surface whose material left along the tool-side normal `n`
-/// is `left_mm` (see [`Corner::overcut_mm`]).
+/// is `left_mm` (see [`Corner::overcut_mm`]), just measured by `probe`.
 fn overcut(probe: &mut Probe, p: &Point3, n: &Vector3, left_mm: f64) -> f64 {
     if left_mm >= 0.0 {
         0.0
     } else {
-        (-left_mm).min(probe.straight_depth(p, n))
+        let depth = match probe.last_straight_depth() {
+            Some(d) => d,
+            None => probe.straight_depth(p, n),
+        };
+        (-left_mm).min(depth)
     }
 }
 

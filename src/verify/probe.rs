@@ -37,6 +37,8 @@ pub struct Probe<'a> {
     seen: Vec<u32>,
     stamp: u32,
     hits: Vec<(u32, Span)>,
+    /// Straight depth of the point last measured, where it was swept.
+    depth: Option<f64>,
 }
 
 impl<'a> Probe<'a> {
@@ -56,6 +58,7 @@ impl<'a> Probe<'a> {
             seen: vec![0; capsules.len()],
             stamp: 0,
             hits: Vec::new(),
+            depth: None,
         }
     }
 
@@ -124,16 +127,21 @@ impl<'a> Probe<'a> {
         }
     }
 
-    /// Measures at `p` along the unit tool-side normal `n`.
+    /// Measures at `p` along the unit tool-side normal `n`. Where `p` was swept, also finds
+    /// its [`Probe::straight_depth`] from the same look ([`Probe::last_straight_depth`]).
     pub fn measure(&mut self, p: &Point3, n: &Vector3) -> Material {
-        // Most points are cut within a cell's length above them: look there first. Every
-        // capsule containing `p` or entered before `near` meets the segment [0, near].
+        // Most points are cut within a cell's length above them or lie in the thin layer a
+        // chord cuts below the surface: one look over [−near, near] serves both. Every
+        // capsule containing `p` or entered before `near` meets that segment.
         let near = self.index.cell_mm().min(self.reach);
-        self.gather(p, n, 0.0, near);
-        if !self.hits.iter().any(|(_, h)| h.t_in <= 0.0) {
+        self.gather(p, n, -near, near);
+        self.depth = None;
+        let contains = |h: &Span| h.t_in <= 0.0 && h.t_out >= 0.0;
+        if !self.hits.iter().any(|(_, h)| contains(h)) {
             if let Some(&(i, h)) = self
                 .hits
                 .iter()
+                .filter(|(_, h)| h.t_in > 0.0 && h.t_in <= near)
                 .min_by(|a, b| a.1.t_in.total_cmp(&b.1.t_in))
             {
                 return self.left(p, n, i, &h);
@@ -150,14 +158,31 @@ impl<'a> Probe<'a> {
                 None => Material::Unreached,
             };
         }
+        // The capsules containing `p` are those whose segment is within the radius of it:
+        // the nearest decides the straight depth.
+        let r = self.radius;
+        let nearest = self
+            .hits
+            .iter()
+            .filter(|(_, h)| contains(h))
+            .map(|&(i, _)| {
+                let c = &self.capsules[i as usize];
+                (c.closest_on_axis(p) - p).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
+        self.depth = Some((r - nearest).max(0.0));
         // The point was swept: follow overlapping capsules downwards to the deepest point of
-        // the swept region connected to it.
+        // the swept region connected to it (the first look's hits serve down to −near).
         let mut lo = -near;
+        let mut first = true;
         loop {
-            self.gather(p, n, lo, 0.0);
+            if !first {
+                self.gather(p, n, lo, 0.0);
+            }
+            first = false;
             let mut deepest: Option<(u32, Span)> = None;
             for &(i, h) in &self.hits {
-                if h.t_in <= 0.0 && h.t_out >= 0.0 && deepest.is_none_or(|(_, d)| h.t_in < d.t_in) {
+                if contains(&h) && deepest.is_none_or(|(_, d)| h.t_in < d.t_in) {
                     deepest = Some((i, h));
                 }
             }
@@ -187,6 +212,12 @@ impl<'a> Probe<'a> {
             }
             return self.left(p, n, d.0, &d.1);
         }
+    }
+
+    /// The [`Probe::straight_depth`] of the point the last [`Probe::measure`] found swept
+    /// (`None` if it was not), found from the same look.
+    pub fn last_straight_depth(&self) -> Option<f64> {
+        self.depth
     }
 }
 

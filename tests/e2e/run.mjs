@@ -453,6 +453,26 @@ test('heat map overlay from the cutting simulation', async (page, url) => {
   return `heat map recolours ${changed} px; re-planned on change to ${cl} CL points`;
 });
 
+test('progressive simulation: a preview heat map from 100 000 samples shows while the simulation at the page defaults runs, then the final one', async (page, url) => {
+  const t0 = Date.now();
+  await page.goto(`${url}?model=keycap-convex&plan=1`);
+  await page.waitForSelector(`${HOST}[data-preview="shown"]`, { timeout: 60000, state: 'attached' });
+  const tPreview = Date.now() - t0;
+  check((await attr(page, 'data-verify')) === 'running', 'the simulation still runs under the preview');
+  check(!(await page.isDisabled('#colour-heat')), 'the heat map can be shown from the preview');
+  await page.check('#colour-heat');
+  const legend = await page.textContent('#heat-legend');
+  check(/Preview from 100,000 samples/.test(legend), `the legend says it is a preview: ${legend}`);
+  await page.screenshot({ path: join(shots, 'heat-preview.png') });
+  await waitVerified(page, 120000);
+  const tFinal = Date.now() - t0;
+  check((await attr(page, 'data-preview')) === null, 'the preview is gone once simulated');
+  const after = await page.textContent('#heat-legend');
+  check(!/Preview/.test(after) && /0\.01 mm left/.test(after), `the final legend: ${after}`);
+  const samples = (await stat(page, 'samples')).text;
+  return `from navigation: preview heat map after ${tPreview} ms, final after ${tFinal} ms (${samples} samples)`;
+});
+
 /** Drops a file on the view, as a user drags one from the desktop. */
 const dropFile = (page, fileName, text) => host(page, (el, [f, t]) => {
   const dt = new DataTransfer();
