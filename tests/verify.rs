@@ -724,3 +724,44 @@ fn face_tsm_creases_are_cut_without_gouging() {
     assert_eq!(v.unreached_samples, 0);
     assert!(v.max_scallop_mm <= h + v.scallop_error_bound_mm);
 }
+
+/// The page's preview (issue 19, progressive simulation): the same samples and heat map as
+/// the full simulation at that count, without the bound between samples (infinite), so it
+/// never passes for a proof.
+#[test]
+fn a_preview_measures_the_same_samples_and_heat_map_and_claims_no_bound() {
+    let m = samples::load_sample("keycap-convex").unwrap();
+    let opts = PlanOptions::default()
+        .with_tool_radius(0.5)
+        .with_scallop(0.01);
+    let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+    let cp = CutterPath::from_toolpath(&planned.toolpath).unwrap();
+    let mesh = m.tessellate(0.02);
+    let full = VerifyOptions::default()
+        .with_samples(100_000)
+        .with_scallop(opts.scallop_mm)
+        .with_gouge_tolerance(opts.chordal_mm);
+    let preview = VerifyOptions {
+        preview: true,
+        ..full.clone()
+    };
+    let (f, fh) = verify::verify_with_heat_map(&m.surface, &cp, &full, &mesh).unwrap();
+    let (p, ph) = verify::verify_with_heat_map(&m.surface, &cp, &preview, &mesh).unwrap();
+    println!(
+        "keycap-convex at {} samples: full max scallop {:.5} mm (bound {:.5} mm, {} cusp samples), preview {:.5} mm (bound {})",
+        f.samples, f.max_scallop_mm, f.error_bound_mm, f.cusp_samples, p.max_scallop_mm, p.error_bound_mm
+    );
+    assert_eq!(p.samples, f.samples);
+    assert!(fh.len() > 1000);
+    assert!(
+        fh.iter().zip(&ph).all(|(a, b)| a.to_bits() == b.to_bits()),
+        "the heat maps differ"
+    );
+    assert!(f.error_bound_mm.is_finite() && f.error_bound_mm < 0.25 * opts.scallop_mm);
+    assert!(p.error_bound_mm.is_infinite() && p.scallop_error_bound_mm.is_infinite());
+    assert_eq!(p.cusp_samples, 0);
+    // The full run also measures at the cusps its bound locates: its maximum is at least
+    // the preview's.
+    assert!(p.max_scallop_mm <= f.max_scallop_mm);
+    assert_eq!(p.mean_scallop_mm.to_bits(), f.mean_scallop_mm.to_bits());
+}

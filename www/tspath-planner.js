@@ -1714,7 +1714,7 @@ export class TspathPlanner extends HTMLElement {
     if (preview >= byKey.samples.min) {
       if (!this.$('status').classList.contains('error')) this.#planStatus(` Simulating a preview of the cut from ${int(preview)} samples…`);
       try {
-        const p = await this.client.call('verify', [{ samples: preview }]);
+        const p = await this.client.call('verify', [{ samples: preview, preview: true }]);
         if (token !== this.verifyToken || plan !== this.plan) return;
         plan.preview = { heat: p.heat, summary: p.summary, samples: preview };
         this.dataset.preview = 'shown';

@@ -431,6 +431,12 @@ fn band(
                 if c.iter().any(|c| !c.reached) {
                     continue;
                 }
+                if ctx.opts.preview {
+                    // No bound between samples: it is unknown.
+                    acc.upper = Some(f64::INFINITY);
+                    acc.gouge_upper = Some(f64::INFINITY);
+                    continue;
+                }
                 let best = [
                     acc.upper.unwrap_or(f64::NEG_INFINITY),
                     acc.gouge_upper.unwrap_or(f64::NEG_INFINITY),

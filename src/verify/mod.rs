@@ -78,6 +78,10 @@ pub struct VerifyOptions {
     /// but kept out of the scallop statistics and counted as `rest_fraction`. Default none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub rest_area: Vec<RestRect>,
+    /// A quick look, not a proof: the samples and the heat map only, without the bound on
+    /// what lies between samples (its refinement is most of the work at coarse sampling);
+    /// the error bounds are then infinite. Default false.
+    pub preview: bool,
 }
 
 /// Largest gouge tolerance a plan's verification uses (mm): two micrometres, what a good
@@ -99,6 +103,7 @@ impl Default for VerifyOptions {
             tool_side: ToolSide::Auto,
             threads: 0,
             rest_area: Vec::new(),
+            preview: false,
         }
     }
 }

@@ -6,6 +6,9 @@ use super::capsule::{Capsule, LineHit, Span};
 use super::index::CapsuleIndex;
 use crate::geom::{Point3, Vector3};
 
+/// Length of the first look along the normal, either way, in index cells.
+const NEAR_CELLS: f64 = 0.1;
+
 /// The capsule that decides a measurement and where the line meets it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Governing {
@@ -133,7 +136,7 @@ impl<'a> Probe<'a> {
         // Most points are cut within a cell's length above them or lie in the thin layer a
         // chord cuts below the surface: one look over [−near, near] serves both. Every
         // capsule containing `p` or entered before `near` meets that segment.
-        let near = self.index.cell_mm().min(self.reach);
+        let near = (NEAR_CELLS * self.index.cell_mm()).min(self.reach);
         self.gather(p, n, -near, near);
         self.depth = None;
         let contains = |h: &Span| h.t_in <= 0.0 && h.t_out >= 0.0;
