@@ -197,7 +197,21 @@ fn gcode_lines_point_at_the_block_of_each_move() {
             }
         }
         assert!(matched > 2 * n, "{dialect}: coordinates checked {matched}");
+        // The program the lines were read from is kept: asked for again, the same bytes.
+        assert_eq!(plan.gcode_for(machine, dialect, units).unwrap(), text);
     }
+    // Kept for its machine, dialect and units only.
+    let kept = plan
+        .gcode_for("table-table-ac", "heidenhain", "inch")
+        .unwrap();
+    let other = plan
+        .gcode_for("table-table-ac", "heidenhain", "mm")
+        .unwrap();
+    assert_ne!(kept, other);
+    assert!(
+        other.contains("MM") && !other.contains("INCH"),
+        "the mm program"
+    );
     let msg = js_message(plan.gcode_lines("3-axis", "klingon", "mm").err().unwrap());
     assert!(msg.contains("klingon"), "{msg}");
 }

@@ -155,8 +155,9 @@ const ops = {
   /** The program for a machine, dialect and units, and the line of each move in it. */
   async post(machine, dialect, units) {
     if (!plan) throw new Error('nothing is planned');
-    const text = plan.gcodeFor(machine, dialect, units);
+    // The lines first: they post the program once and keep it for gcodeFor.
     const lines = plan.gcodeLines(machine, dialect, units);
+    const text = plan.gcodeFor(machine, dialect, units);
     // The machining time on the machine the program is for.
     plan.timeOn(machine);
     const { machining_time_min: minutes, time_machine: timeMachine, notes } = plan.report();

@@ -629,7 +629,7 @@ pub(super) fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptio
 }
 
 /// Halvings of a blocked turn before it is given up.
-const BRIDGE_DEPTH: usize = 6;
+pub(super) const BRIDGE_DEPTH: usize = 6;
 
 /// Appends to `out` cut points between `a` and `b` (at fractions of the way from `s0` to
 /// `s1`) that split a blocked turn into clear ones, or a turn larger than
@@ -638,7 +638,7 @@ const BRIDGE_DEPTH: usize = 6;
 /// clear, else the least tilt leaning from `a`'s; then each half likewise. False if some
 /// turn stays blocked.
 #[allow(clippy::too_many_arguments)]
-fn bridge(
+pub(super) fn bridge(
     a: &Move,
     b: &Move,
     (s0, s1): (f64, f64),

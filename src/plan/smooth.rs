@@ -274,27 +274,36 @@ fn spread(
         .enumerate()
         .map(|(j, &k)| cands[j][k])
         .collect();
-    // Keep only a real gain that blocks no more turns.
     let largest = |axes: &dyn Fn(usize) -> Vector3| {
         (1..=r - l)
             .map(|j| axes(j - 1).angle(&axes(j)))
             .fold(0.0, f64::max)
     };
     let (before, after) = (largest(&own), largest(&|j| chosen[j]));
-    if after >= before - SAME_AXIS_RAD {
-        return false;
-    }
     let blocked = |axes: &dyn Fn(usize) -> Vector3| {
         (1..=r - l)
             .filter(|&j| {
                 let (mut a, mut b) = (moves[l + j - 1], moves[l + j]);
                 a.tool_axis = axes(j - 1);
                 b.tool_axis = axes(j);
+                // Blocked for good: the bridging that follows cannot split it clear.
                 axis::turn_blocked(&a, &b, obs, opts)
+                    && !axis::bridge(
+                        &a,
+                        &b,
+                        (0.0, 1.0),
+                        obs,
+                        opts,
+                        axis::BRIDGE_DEPTH,
+                        &mut Vec::new(),
+                    )
             })
             .count()
     };
-    if blocked(&|j| chosen[j]) > blocked(&own) {
+    // Fewer turns the shank or holder cannot make first (the larger turns left are split
+    // later), then a smaller largest turn.
+    let (was, now) = (blocked(&own), blocked(&|j| chosen[j]));
+    if now > was || (now == was && after >= before - SAME_AXIS_RAD) {
         return false;
     }
     for (j, v) in chosen.into_iter().enumerate() {

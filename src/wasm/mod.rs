@@ -13,6 +13,7 @@ use crate::plan::watershed::layer::Layer as WatershedLayer;
 use crate::plan::{PlanOptions, PlanReport, Toolpath};
 use crate::surface::tessellate::Tessellation;
 use crate::verify::{self, CutterPath, RestRect, Verification, VerifyOptions};
+use std::cell::RefCell;
 use wasm_bindgen::prelude::*;
 
 fn js_err(e: Error) -> JsError {
@@ -315,6 +316,7 @@ impl WasmModel {
             rest_rects,
             rest_positions,
             rest_why,
+            posted: RefCell::new(None),
         }
     }
 }
@@ -476,6 +478,9 @@ pub struct WasmPlan {
     isfc_layer: Option<IsfcLayer>,
     /// The rectangles (`watershed` and `multi-rectangle` plans only), kept from planning.
     watershed_layer: Option<WatershedLayer>,
+    /// The last program `gcodeLines` posted and what for (machine, dialect, units), so that
+    /// `gcodeFor` the same does not post it again.
+    posted: RefCell<Option<([String; 3], String)>>,
 }
 
 impl WasmPlan {
@@ -660,6 +665,12 @@ impl WasmPlan {
         let m = machine::resolve(machine).map_err(js_err)?;
         let d = Dialect::parse(dialect).map_err(js_err)?;
         let u = Units::parse(units).map_err(js_err)?;
+        let key = [machine, dialect, units].map(str::to_string);
+        if let Some((k, text)) = self.posted.borrow().as_ref() {
+            if *k == key {
+                return Ok(text.clone());
+            }
+        }
         machine::post(&self.path, &self.opts, &self.job, &m, d, u).map_err(js_err)
     }
 
@@ -691,6 +702,8 @@ impl WasmPlan {
         let posted = machine::post::post_program(&self.path, &self.opts, &self.job, &m, d, u)
             .map_err(js_err)?;
         let program = machine::reader::read(&posted.text).map_err(js_err)?;
+        let key = [machine, dialect, units].map(str::to_string);
+        *self.posted.borrow_mut() = Some((key, posted.text.clone()));
         if program.moves.len() != posted.sources.len() {
             return Err(JsError::new(&format!(
                 "the program reads back {} motion blocks, the post wrote {}",
