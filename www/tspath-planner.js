@@ -1617,6 +1617,13 @@ export class TspathPlanner extends HTMLElement {
     } else if (this.dataset.verify === 'running') {
       this.dataset.verify = 'cancelled';
       this.$('cancel').disabled = true;
+      if (this.plan && this.plan.preview) {
+        // The preview stood for a simulation that no longer runs.
+        this.plan.preview = null;
+        delete this.dataset.preview;
+        this.$('colour-heat').disabled = true;
+        this.#showColours();
+      }
       if (!quiet) this.#status('Simulation cancelled.');
     }
     this.dataset.cancelMs = String(Math.round(performance.now() - t0));
@@ -1708,8 +1715,8 @@ export class TspathPlanner extends HTMLElement {
     this.#showColours();
     if (!(await this.#ensureWorkerPlan())) return;
     const start = values.samples;
-    // A coarse heat map first, a tenth of the work or less, shown while the simulation that
-    // proves the scallop runs.
+    // A coarse heat map first (no bound between samples: a small share of the work), shown
+    // while the simulation that proves the scallop runs.
     const preview = Math.min(PREVIEW_SAMPLES, Math.floor(start / 4));
     if (preview >= byKey.samples.min) {
       if (!this.$('status').classList.contains('error')) this.#planStatus(` Simulating a preview of the cut from ${int(preview)} samples…`);

@@ -663,13 +663,31 @@ pub(super) fn bridge(
     let halfway = (a.tool_axis + b.tool_axis)
         .try_normalize(AXIS_MIN_NORM)
         .filter(|x| within_tilt(x, opts) && usable(obs, (&cl, &n), x, opts));
-    // A clear turn that is only too large is halved along its way.
-    let axis = match (blocked, halfway) {
-        (false, Some(x)) => Some(x),
-        _ => match vertical_hit(obs, (&cl, &n), &cc, opts) {
-            None => Some(Vector3::z()),
-            Some(h) => halfway.or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
-        },
+    if !blocked {
+        // A clear turn that is only too large is halved along its way, or left whole where
+        // that is not clear: a split must never make a clear turn blocked.
+        let Some(axis) = halfway else {
+            return true;
+        };
+        let kept = out.len();
+        let mid = Move {
+            cl_point: cl,
+            cc_point: cc,
+            tool_axis: axis,
+            ..*b
+        };
+        let sm = 0.5 * (s0 + s1);
+        let first = bridge(a, &mid, (s0, sm), obs, opts, depth - 1, out);
+        out.push((mid, sm));
+        let second = bridge(&mid, b, (sm, s1), obs, opts, depth - 1, out);
+        if !(first && second) {
+            out.truncate(kept);
+        }
+        return true;
+    }
+    let axis = match vertical_hit(obs, (&cl, &n), &cc, opts) {
+        None => Some(Vector3::z()),
+        Some(h) => halfway.or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
     };
     let Some(axis) = axis else {
         return false;

@@ -51,6 +51,9 @@ pub struct SmoothStats {
     /// Windows around large turns tried, and those whose axes changed.
     pub windows: usize,
     pub smoothed: usize,
+    /// Windows left as they were because the work budget was spent (their large turns are
+    /// split by poses in between).
+    pub over_budget: usize,
     /// Largest turn between neighbouring cut points before and after (degrees).
     pub largest_before_deg: f64,
     pub largest_after_deg: f64,
@@ -87,6 +90,8 @@ pub fn spread_turns(
         chains.push((s, i));
         i += 1;
     }
+    let budget = (n / BUDGET_SHARE).max(LEAST_BUDGET);
+    let mut spent = 0;
     for (s, e) in chains {
         // Turns a window cannot spread are tried again in wider windows.
         for (round, widen) in WIDEN.into_iter().enumerate() {
@@ -96,6 +101,12 @@ pub fn spread_turns(
                 stats.largest_before_deg = stats.largest_before_deg.max(largest);
             }
             for (l, r) in windows {
+                // Bounded work: past the budget, large turns are only split.
+                if spent >= budget {
+                    stats.over_budget += 1;
+                    continue;
+                }
+                spent += r - l + 1;
                 stats.windows += 1;
                 if spread(obs, path, opts, (l, r), (l == s, r == e)) {
                     stats.smoothed += 1;
@@ -143,7 +154,7 @@ fn windows(
         let l = k.saturating_sub(half + 1).max(s);
         let r = (k + half).min(e);
         match out.last_mut() {
-            Some(w) if l <= w.1 && r - w.0 < MAX_WINDOW => w.1 = r,
+            Some(w) if l <= w.1 && w.1.max(r) - w.0 < MAX_WINDOW => w.1 = w.1.max(r),
             _ => out.push((l, r)),
         }
     }
@@ -166,8 +177,9 @@ fn slerp(a: &Vector3, b: &Vector3, t: f64) -> Option<Vector3> {
 }
 
 /// Spreads the turns of window `l..=r` (`free`: whether each end may change, at a pass's
-/// start or end) by dynamic programming; keeps the new axes if the largest turn falls and
-/// no more turns are blocked for the shank and holder. True if it changed them.
+/// start or end) by dynamic programming; keeps the new axes if they leave fewer turns the
+/// bridging cannot make clear, or as many and a smaller largest turn. True if it changed
+/// them.
 fn spread(
     obs: &Clearance,
     path: &mut Toolpath,
@@ -311,6 +323,11 @@ fn spread(
     }
     true
 }
+
+/// Work budget: the windows' points in all, at most the path's moves over this, and at
+/// least [`LEAST_BUDGET`] (each window point tries some 30 candidate axes).
+const BUDGET_SHARE: usize = 8;
+const LEAST_BUDGET: usize = 4000;
 
 /// Rounds of excluding blocked turns from the cheapest path.
 const BAN_ROUNDS: usize = 8;

@@ -818,13 +818,15 @@ fn run_items(
     }
 }
 
-fn summarise(patch: u32, grid: [usize; 2], acc: &Acc) -> PatchVerification {
+/// The summary of `acc`; a `preview` bounds nothing between samples (infinite bounds).
+fn summarise(patch: u32, grid: [usize; 2], acc: &Acc, preview: bool) -> PatchVerification {
     let frac = |a: f64| if acc.area > 0.0 { a / acc.area } else { 0.0 };
     let max_scallop = acc.max_left.map_or(0.0, |m| m.max(0.0));
-    let scallop_bound = acc.upper.map_or(0.0, |u| (u - max_scallop).max(0.0));
+    let unbounded = if preview { f64::INFINITY } else { 0.0 };
+    let scallop_bound = acc.upper.map_or(unbounded, |u| (u - max_scallop).max(0.0));
     let gouge_bound = acc
         .gouge_upper
-        .map_or(0.0, |g| (g - acc.max_gouge.max(0.0)).max(0.0));
+        .map_or(unbounded, |g| (g - acc.max_gouge.max(0.0)).max(0.0));
     PatchVerification {
         patch,
         samples: acc.samples,
@@ -926,13 +928,13 @@ pub(super) fn run(
     let patches: Vec<PatchVerification> = per_face
         .iter()
         .enumerate()
-        .map(|(fi, a)| summarise(fi as u32, [grids[fi].nu, grids[fi].nv], a))
+        .map(|(fi, a)| summarise(fi as u32, [grids[fi].nu, grids[fi].nv], a, opts.preview))
         .collect();
     let mut all = Acc::default();
     for a in per_face {
         all.merge(a);
     }
-    let o = summarise(u32::MAX, [0, 0], &all);
+    let o = summarise(u32::MAX, [0, 0], &all, opts.preview);
     Verification {
         tool_radius_mm: r,
         requested_scallop_mm: opts.scallop_mm,
