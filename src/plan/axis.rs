@@ -663,13 +663,8 @@ pub(super) fn bridge(
     let halfway = (a.tool_axis + b.tool_axis)
         .try_normalize(AXIS_MIN_NORM)
         .filter(|x| within_tilt(x, opts) && usable(obs, (&cl, &n), x, opts));
-    if !blocked {
-        // A clear turn that is only too large is halved along its way, or left whole where
-        // that is not clear: a split must never make a clear turn blocked.
-        let Some(axis) = halfway else {
-            return true;
-        };
-        let kept = out.len();
+    // Both halves through the pose with `axis` at the chord's midpoint.
+    let halves = |axis: Vector3, out: &mut Vec<(Move, f64)>| {
         let mid = Move {
             cl_point: cl,
             cc_point: cc,
@@ -680,7 +675,16 @@ pub(super) fn bridge(
         let first = bridge(a, &mid, (s0, sm), obs, opts, depth - 1, out);
         out.push((mid, sm));
         let second = bridge(&mid, b, (sm, s1), obs, opts, depth - 1, out);
-        if !(first && second) {
+        first && second
+    };
+    if !blocked {
+        // A clear turn that is only too large is halved along its way, or left whole where
+        // that is not clear: a split must never make a clear turn blocked.
+        let Some(axis) = halfway else {
+            return true;
+        };
+        let kept = out.len();
+        if !halves(axis, out) {
             out.truncate(kept);
         }
         return true;
@@ -689,20 +693,10 @@ pub(super) fn bridge(
         None => Some(Vector3::z()),
         Some(h) => halfway.or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
     };
-    let Some(axis) = axis else {
-        return false;
-    };
-    let mid = Move {
-        cl_point: cl,
-        cc_point: cc,
-        tool_axis: axis,
-        ..*b
-    };
-    let sm = 0.5 * (s0 + s1);
-    let first = bridge(a, &mid, (s0, sm), obs, opts, depth - 1, out);
-    out.push((mid, sm));
-    let second = bridge(&mid, b, (sm, s1), obs, opts, depth - 1, out);
-    first && second
+    match axis {
+        Some(axis) => halves(axis, out),
+        None => false,
+    }
 }
 
 /// Splits every turn of the axis between two cut points whose in-between poses would put
