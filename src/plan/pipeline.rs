@@ -146,8 +146,7 @@ pub fn finish(
         progress(0.3 + 0.5 * f)
     })?;
     // Large turns between neighbouring cut points spread over the points around them.
-    let spread = smooth::spread_turns(&obs, &mut draft.toolpath, opts, &why);
-    axes.spread = spread.smoothed;
+    axes.spread = smooth::spread_turns(&obs, &mut draft.toolpath, opts, &why);
     // 3. Split the cuts there and route the air moves; where the ball cannot get to a cut or
     //    away from it, leave those points out too and split again.
     let dist = SurfaceDistance::new(model, (AIR_TESSELLATION_SHARE * r).max(opts.overcut_mm()));

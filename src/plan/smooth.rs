@@ -45,33 +45,20 @@ const DEPARTURE_WEIGHT: f64 = 0.02;
 /// turn falls first.
 const EXCESS_WEIGHT: f64 = 100.0;
 
-/// What spreading the turns did.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct SmoothStats {
-    /// Windows around large turns tried, and those whose axes changed.
-    pub windows: usize,
-    pub smoothed: usize,
-    /// Windows left as they were because the work budget was spent (their large turns are
-    /// split by poses in between).
-    pub over_budget: usize,
-    /// Largest turn between neighbouring cut points before and after (degrees).
-    pub largest_before_deg: f64,
-    pub largest_after_deg: f64,
-}
-
 /// Spreads the large axis turns of `path` (see the module), unless the axes follow the
-/// surface normal by request. Points with a `why` (not cut) break the passes.
+/// surface normal by request. Points with a `why` (not cut) break the passes. Returns how
+/// many windows of axes it changed.
 pub fn spread_turns(
     obs: &Clearance,
     path: &mut Toolpath,
     opts: &PlanOptions,
     why: &[Option<Why>],
-) -> SmoothStats {
-    let mut stats = SmoothStats::default();
+) -> usize {
+    let mut smoothed = 0;
     // Axes the user asked to follow the surface (lead and tilt from the normal, the
     // facets' normal) are kept: their large turns follow the surface and are split.
     if opts.lead_deg != 0.0 || opts.tilt_deg != 0.0 || opts.facet_normal_axis {
-        return stats;
+        return smoothed;
     }
     let n = path.moves.len();
     let cut = |i: usize| path.moves[i].kind.on_surface() && why[i].is_none();
@@ -94,31 +81,20 @@ pub fn spread_turns(
     let mut spent = 0;
     for (s, e) in chains {
         // Turns a window cannot spread are tried again in wider windows.
-        for (round, widen) in WIDEN.into_iter().enumerate() {
-            let mut largest = 0.0;
-            let windows = windows(path, opts, (s, e), widen, &mut largest);
-            if round == 0 {
-                stats.largest_before_deg = stats.largest_before_deg.max(largest);
-            }
-            for (l, r) in windows {
+        for widen in WIDEN {
+            for (l, r) in windows(path, opts, (s, e), widen) {
                 // Bounded work: past the budget, large turns are only split.
                 if spent >= budget {
-                    stats.over_budget += 1;
                     continue;
                 }
                 spent += r - l + 1;
-                stats.windows += 1;
                 if spread(obs, path, opts, (l, r), (l == s, r == e)) {
-                    stats.smoothed += 1;
+                    smoothed += 1;
                 }
             }
         }
-        for k in s + 1..=e {
-            let t = step_deg(path, k);
-            stats.largest_after_deg = stats.largest_after_deg.max(t);
-        }
     }
-    stats
+    smoothed
 }
 
 /// Turns larger than this are spread (degrees).
@@ -135,18 +111,16 @@ fn step_deg(path: &Toolpath, k: usize) -> f64 {
 }
 
 /// The windows `(first, last)` around the large turns of the chain `s..=e`, merged where
-/// they overlap, `widen` times the usual size; raises `largest` to the chain's largest turn.
+/// they overlap, `widen` times the usual size.
 fn windows(
     path: &Toolpath,
     opts: &PlanOptions,
     (s, e): (usize, usize),
     widen: usize,
-    largest: &mut f64,
 ) -> Vec<(usize, usize)> {
     let mut out: Vec<(usize, usize)> = Vec::new();
     for k in s + 1..=e {
         let t = step_deg(path, k);
-        *largest = largest.max(t);
         if t <= spot_deg(opts) {
             continue;
         }
