@@ -4,28 +4,30 @@
 //!
 //! The ball itself cannot gouge where it touches (the side step keeps concave radii larger
 //! than the ball), and the fluted length above it cuts; the non-cutting shank above the
-//! flutes and the holder above the shank can hit walls elsewhere. The model is sampled densely
-//! (tessellation vertices and triangle centres) into a spatial grid; a candidate axis is clear
-//! when no sample lies inside the cylinders grown by the sampling gap. +Z is tested against a
-//! height map first (cheap); where it is not clear, the tool leans the way the previous
-//! point leaned (or the nearest way that is clear), else away from the obstacle, at the
-//! least clear tilt that way, refined by bisection. The least clear tilt changes
+//! flutes and the holder above the shank can hit walls elsewhere. A candidate axis is clear
+//! when no triangle of a tessellation of the model meets the shank or holder cylinder grown
+//! by the tessellation's deviation ([`super::clearance`]). Where +Z is not clear, the tool
+//! leans the way the previous point leaned (or the nearest way that is clear), else away
+//! from the obstacle, at the least clear tilt that way, found by a galloping search from
+//! the previous point's tilt. The least clear tilt changes
 //! continuously as the tool nears a wall, so the axis turns gradually without smoothing,
 //! and it is +Z wherever +Z is clear.
 
+use super::clearance::Clearance;
 use super::reach::Why;
 use super::toolpath::{Move, MoveKind, Toolpath};
 use super::PlanOptions;
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
-use crate::model::Model;
 
 /// Azimuths tried around +Z when the usual ones fail.
 const AZIMUTHS: usize = 12;
-/// Step of the coarse tilt search (degrees).
-const TILT_STEP_DEG: f64 = 5.0;
-/// Bisection steps refining the tilt (5° / 2^6 ≈ 0.08°).
-const TILT_BISECTIONS: usize = 6;
+/// Resolution of the least clear tilt (degrees): tilts are whole multiples of it. Two
+/// decimals, so that a tilt printed to four (the program's angles) never sits on a rounding
+/// tie that the last bit of an arc cosine could tip either way.
+const TILT_RESOLUTION_DEG: f64 = 0.08;
+/// Step of the coarse tilt search, in resolutions (64 × 0.08° = 5.12°).
+const TILT_STEP_UNITS: i64 = 64;
 /// Least cosine between the tool axis and the surface normal at the contact point: the
 /// tool must come from the side the surface faces (else its flutes and shank run into the
 /// part behind the contact, as under a closed part's bottom) (cos 88°).
@@ -66,387 +68,8 @@ pub(super) fn contact_normal(m: &Move) -> Vector3 {
 /// Azimuths either side of "away from the obstacle" also tried (radians, 30°).
 const SIDE_AZIMUTH: f64 = std::f64::consts::FRAC_PI_6;
 
-/// Dense samples of the model's surface in a uniform grid, with a height map for vertical
-/// axes.
-pub struct Obstacles {
-    cell: f64,
-    /// Samples sorted by grid cell: those of cell `k` are `sorted[start[k]..start[k + 1]]`
-    /// (single precision: half the memory; the rounding is added to the gap).
-    sorted: Vec<[f32; 3]>,
-    start: Vec<u32>,
-    /// Grid origin and size in cells.
-    origin: [f64; 3],
-    dims: [usize; 3],
-    /// Highest sample per column of the grid, dense over the model's x–y extent, at the
-    /// grid's cell size and at [`COARSE`] times it.
-    heights: HeightMap,
-    coarse: HeightMap,
-    /// Highest point of the model (mm).
-    top: f64,
-    /// Largest distance from any surface point to its nearest sample (mm): cylinders are
-    /// grown by this much.
-    pub gap_mm: f64,
-}
-
-impl Obstacles {
-    /// Samples the model for collision tests, no two neighbouring samples farther apart
-    /// than `spacing` (mm), indexed in cells of about `cell_mm` (at most the model's size
-    /// over `GRID_CELLS`, at least the sampling gap).
-    pub fn new(model: &Model, spacing: f64, cell_mm: f64) -> Obstacles {
-        let size = model.surface.bbox().diagonal().max(1e-6);
-        let chordal = (0.25 * spacing).max(size * 2e-4);
-        let t = model.tessellate(chordal);
-        let vertices: Vec<Point3> = t
-            .positions
-            .chunks(3)
-            .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
-            .collect();
-        // Lattice divisions per triangle side, and the lattice spacing reached.
-        let mut worst: f64 = 0.0;
-        let divisions: Vec<usize> = t
-            .indices
-            .chunks(3)
-            .map(|tri| {
-                let [a, b, c] = [0, 1, 2].map(|k| vertices[tri[k] as usize]);
-                let longest = (a - b).norm().max((b - c).norm()).max((c - a).norm());
-                let n = ((longest / spacing).ceil() as usize).max(1);
-                worst = worst.max(longest / n as f64);
-                n
-            })
-            .collect();
-        // Every sample: the vertices, and inside each triangle a barycentric lattice of `n`
-        // divisions per side (spacing longest / n). Generated again for each pass instead
-        // of stored: the samples of a large model at a thin shank's spacing run to millions.
-        let each_sample = |f: &mut dyn FnMut(&Point3)| {
-            vertices.iter().for_each(&mut *f);
-            for (tri, &n) in t.indices.chunks(3).zip(&divisions) {
-                let [a, b, c] = [0, 1, 2].map(|k| vertices[tri[k] as usize]);
-                for i in 0..=n {
-                    for j in 0..=n - i {
-                        let k = n - i - j;
-                        if i == n || j == n || k == n {
-                            continue; // the vertices are in already
-                        }
-                        let [x, y, z] = [i, j, k].map(|m| m as f64 / n as f64);
-                        f(&Point3::from(a.coords * x + b.coords * y + c.coords * z));
-                    }
-                }
-            }
-        };
-        // Lattice points lie in their triangles: the vertices bound them all.
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for q in &vertices {
-            for k in 0..3 {
-                lo[k] = lo[k].min(q[k]);
-                hi[k] = hi[k].max(q[k]);
-            }
-        }
-        let reach = (0..3)
-            .map(|k| lo[k].abs().max(hi[k].abs()))
-            .fold(0.0, f64::max);
-        // Every point of a triangle is within 0.58 of the lattice spacing of a lattice point,
-        // and the surface within the chordal tolerance of the triangle.
-        let gap_mm = 0.58 * worst + chordal + F32_ROUNDING * reach;
-        let cell = cell_mm.min(size / GRID_CELLS).max(gap_mm);
-        let dims = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).max(1));
-        let index = |q: &Point3| {
-            let c = [0, 1, 2].map(|k| (((q[k] - lo[k]) / cell) as usize).min(dims[k] - 1));
-            (c[2] * dims[1] + c[1]) * dims[0] + c[0]
-        };
-        let mut heights = HeightMap::new(lo, hi, cell);
-        let mut coarse = HeightMap::new(lo, hi, cell * COARSE);
-        let mut start = vec![0u32; dims[0] * dims[1] * dims[2] + 1];
-        each_sample(&mut |q| {
-            start[index(q) + 1] += 1;
-            heights.add(q);
-            coarse.add(q);
-        });
-        for k in 1..start.len() {
-            start[k] += start[k - 1];
-        }
-        let mut fill = start.clone();
-        let mut sorted = vec![[0.0f32; 3]; start[start.len() - 1] as usize];
-        each_sample(&mut |q| {
-            let k = index(q);
-            sorted[fill[k] as usize] = [q.x as f32, q.y as f32, q.z as f32];
-            fill[k] += 1;
-        });
-        Obstacles {
-            cell,
-            sorted,
-            start,
-            origin: lo,
-            dims,
-            heights,
-            coarse,
-            top: model.surface.bbox().max[2],
-            gap_mm,
-        }
-    }
-
-    /// True if no sample within `radius` of `c` (in x–y) rises above `z`.
-    fn below(&self, c: &Point3, radius: f64, z: f64) -> bool {
-        let map = if radius > COARSE * self.cell {
-            &self.coarse
-        } else {
-            &self.heights
-        };
-        map.below(c, radius, z)
-    }
-
-    /// A sample inside the cylinder from `c + axis·a0` to `c + axis·a1` of radius `rad` (all
-    /// grown by the sampling gap), if there is one.
-    fn cylinder_hit(
-        &self,
-        c: &Point3,
-        axis: &Vector3,
-        a0: f64,
-        a1: f64,
-        rad: f64,
-    ) -> Option<Point3> {
-        let g = self.gap_mm;
-        let rad = rad + g;
-        let (p0, p1) = (c + axis * (a0 - g), c + axis * (a1 + g));
-        // Entirely above the model: nothing to hit.
-        let lowest = p0.z.min(p1.z) - rad * (1.0 - axis.z * axis.z).max(0.0).sqrt();
-        if lowest > self.top + g {
-            return None;
-        }
-        let test = |q: &Point3| {
-            let d = q - c;
-            let axial = d.dot(axis);
-            axial > a0 - g && axial < a1 + g && (d - axis * axial).norm() < rad
-        };
-        self.find_near_segment(&p0, &p1, rad, test)
-    }
-
-    /// A sample closer than `rad` to the segment from `p0` to `p1` (the ball swept along it),
-    /// if there is one. Samples stand for the surface only to within the sampling gap, so a
-    /// touch shallower than that may go unseen.
-    fn capsule_hit(&self, p0: &Point3, p1: &Point3, rad: f64) -> Option<Point3> {
-        let d = p1 - p0;
-        let len2 = d.norm_squared();
-        let test = |q: &Point3| {
-            let t = if len2 > 0.0 {
-                ((q - p0).dot(&d) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (p0 + d * t - q).norm() < rad
-        };
-        self.find_near_segment(p0, p1, rad, test)
-    }
-
-    /// The first sample passing `test` among those of the grid cells that come within
-    /// `rad` of the segment from `p0` to `p1` (every sample passing `test` must lie there).
-    fn find_near_segment(
-        &self,
-        p0: &Point3,
-        p1: &Point3,
-        rad: f64,
-        test: impl Fn(&Point3) -> bool,
-    ) -> Option<Point3> {
-        let lo = [0, 1, 2].map(|k| p0[k].min(p1[k]) - rad);
-        let hi = [0, 1, 2].map(|k| p0[k].max(p1[k]) + rad);
-        // Cell ranges, clamped to the grid (samples outside it do not exist).
-        let range = |k: usize| -> Option<(usize, usize)> {
-            let a = ((lo[k] - self.origin[k]) / self.cell).floor();
-            let b = ((hi[k] - self.origin[k]) / self.cell).floor();
-            if b < 0.0 || a > (self.dims[k] - 1) as f64 {
-                return None;
-            }
-            Some((a.max(0.0) as usize, (b as usize).min(self.dims[k] - 1)))
-        };
-        let (rx, ry, rz) = (range(0)?, range(1)?, range(2)?);
-        let d = p1 - p0;
-        let len2 = d.norm_squared();
-        // A cell can hold a sample within `rad` of the segment only if its centre is within
-        // `rad` plus half its diagonal.
-        let reach = rad + 0.5 * 3f64.sqrt() * self.cell;
-        let reach2 = reach * reach;
-        let half = 0.5 * self.cell;
-        for k in rz.0..=rz.1 {
-            let z = self.origin[2] + k as f64 * self.cell + half;
-            for j in ry.0..=ry.1 {
-                let y = self.origin[1] + j as f64 * self.cell + half;
-                let row = (k * self.dims[1] + j) * self.dims[0];
-                for i in rx.0..=rx.1 {
-                    let (a, b) = (
-                        self.start[row + i] as usize,
-                        self.start[row + i + 1] as usize,
-                    );
-                    if a == b {
-                        continue;
-                    }
-                    let q = Point3::new(self.origin[0] + i as f64 * self.cell + half, y, z);
-                    let t = if len2 > 0.0 {
-                        ((q - p0).dot(&d) / len2).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    if (p0 + d * t - q).norm_squared() > reach2 {
-                        continue;
-                    }
-                    if let Some(p) = self.sorted[a..b]
-                        .iter()
-                        .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
-                        .find(|q| test(q))
-                    {
-                        return Some(p);
-                    }
-                }
-            }
-        }
-        None
-    }
-
-    /// A sample inside the cylinder from `c + axis·a0` to `c + axis·a1` of radius `rad`
-    /// (grown by the sampling gap), if there is one; vertical axes are tried on the height
-    /// map first.
-    fn segment_hit(
-        &self,
-        c: &Point3,
-        axis: &Vector3,
-        (a0, a1): (f64, f64),
-        rad: f64,
-    ) -> Option<Point3> {
-        if axis.z > 1.0 - VERTICAL_COS_SLACK
-            && self.below(c, rad + self.gap_mm, c.z + a0 - self.gap_mm)
-        {
-            return None;
-        }
-        self.cylinder_hit(c, axis, a0, a1, rad)
-    }
-}
-
-/// Axes this close to +Z (1 − cos of the angle) are vertical for the height-map test.
+/// Axes this close to +Z (1 − cos of the angle) count as vertical.
 const VERTICAL_COS_SLACK: f64 = 1e-15;
-
-/// The model sampled for collision tests of the tool above its flutes: densely for the thin
-/// shank, more coarsely for the wide holder (each set grows its cylinder by its own gap).
-pub struct Clearance {
-    shank: Obstacles,
-    /// `None`: the holder is tested against the shank's samples (when a coarser set would
-    /// hardly be coarser).
-    holder: Option<Obstacles>,
-}
-
-impl Clearance {
-    /// Samples `model` for the shank and holder of `opts`.
-    pub fn new(model: &Model, opts: &PlanOptions) -> Clearance {
-        let most = model.surface.bbox().diagonal() / OBSTACLE_SAMPLES;
-        let fine = (SHANK_SPACING * opts.shank_radius()).min(most);
-        let coarse = (HOLDER_SPACING * opts.holder_radius_mm).min(most).max(fine);
-        // Cells about the size of the cylinder tested in them.
-        let shank = Obstacles::new(model, fine, CELL_RADII * opts.shank_radius());
-        let holder = (coarse > 2.0 * fine)
-            .then(|| Obstacles::new(model, coarse, CELL_RADII * opts.holder_radius_mm));
-        Clearance { shank, holder }
-    }
-
-    fn holder(&self) -> &Obstacles {
-        self.holder.as_ref().unwrap_or(&self.shank)
-    }
-
-    /// Largest sampling gap of the two sets (mm).
-    pub fn gap_mm(&self) -> f64 {
-        self.shank.gap_mm.max(self.holder().gap_mm)
-    }
-
-    /// A sample inside the shank (above the flutes) or the holder of a tool with its ball
-    /// centre at `c` along unit `axis`, if there is one.
-    pub fn hit(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> Option<Point3> {
-        let (f, ls, lh) = (
-            opts.flute_length(),
-            opts.shank_length_mm,
-            opts.holder_length_mm,
-        );
-        self.shank
-            .segment_hit(c, axis, (f, ls), opts.shank_radius())
-            .or_else(|| {
-                self.holder()
-                    .segment_hit(c, axis, (ls, ls + lh), opts.holder_radius_mm)
-            })
-    }
-
-    /// True if the shank and holder at `c` along `axis` are clear of every sample.
-    pub fn clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
-        self.hit(c, axis, opts).is_none()
-    }
-
-    /// A sample closer than `rad` to the segment from `p0` to `p1`, from the dense set.
-    pub fn capsule_hit(&self, p0: &Point3, p1: &Point3, rad: f64) -> Option<Point3> {
-        self.shank.capsule_hit(p0, p1, rad)
-    }
-}
-
-/// Obstacle grid cell size, in radii of the cylinder tested against it.
-const CELL_RADII: f64 = 2.0;
-/// Shank obstacle sample spacing, in shank radii.
-const SHANK_SPACING: f64 = 0.25;
-/// Holder obstacle sample spacing, in holder radii.
-const HOLDER_SPACING: f64 = 0.04;
-
-/// Relative rounding of a coordinate stored in single precision (2⁻²⁴).
-const F32_ROUNDING: f64 = 6.0e-8;
-
-/// Ratio of the coarse height map's cell to the fine one's.
-const COARSE: f64 = 8.0;
-
-/// Highest sample in each cell of a dense x–y grid.
-struct HeightMap {
-    cell: f64,
-    origin: [f64; 2],
-    nx: usize,
-    ny: usize,
-    max_z: Vec<f64>,
-}
-
-impl HeightMap {
-    /// An empty map over the x–y extent of the box from `lo` to `hi`.
-    fn new(lo: [f64; 3], hi: [f64; 3], cell: f64) -> HeightMap {
-        let nx = (((hi[0] - lo[0]) / cell).floor() as usize + 1).max(1);
-        let ny = (((hi[1] - lo[1]) / cell).floor() as usize + 1).max(1);
-        HeightMap {
-            cell,
-            origin: [lo[0], lo[1]],
-            nx,
-            ny,
-            max_z: vec![f64::NEG_INFINITY; nx * ny],
-        }
-    }
-
-    /// Raises the column of `p` to its height.
-    fn add(&mut self, p: &Point3) {
-        let i = (((p.x - self.origin[0]) / self.cell) as usize).min(self.nx - 1);
-        let j = (((p.y - self.origin[1]) / self.cell) as usize).min(self.ny - 1);
-        let h = &mut self.max_z[j * self.nx + i];
-        *h = h.max(p.z);
-    }
-
-    fn below(&self, c: &Point3, radius: f64, z: f64) -> bool {
-        let idx =
-            |x: f64, o: f64, n: usize| (((x - o) / self.cell).floor().max(0.0) as usize).min(n - 1);
-        let (i0, i1) = (
-            idx(c.x - radius, self.origin[0], self.nx),
-            idx(c.x + radius, self.origin[0], self.nx),
-        );
-        let (j0, j1) = (
-            idx(c.y - radius, self.origin[1], self.ny),
-            idx(c.y + radius, self.origin[1], self.ny),
-        );
-        (j0..=j1).all(|j| {
-            self.max_z[j * self.nx + i0..=j * self.nx + i1]
-                .iter()
-                .all(|&h| h <= z)
-        })
-    }
-}
-
-/// Obstacle samples along the model's diagonal, at the least.
-const OBSTACLE_SAMPLES: f64 = 150.0;
-/// Grid cells along the model's diagonal in the obstacle index.
-const GRID_CELLS: f64 = 64.0;
 
 /// Unit axis tilted `theta` (radians) from +Z towards azimuth `phi`.
 pub(super) fn tilted(theta: f64, phi: f64) -> Vector3 {
@@ -457,11 +80,12 @@ pub(super) fn tilted(theta: f64, phi: f64) -> Vector3 {
     )
 }
 
-/// The least tilt (radians) along azimuth `phi` at which the tool is clear, to within the
-/// bisection: coarse steps of [`TILT_STEP_DEG`] up to the largest allowed, refined by
-/// bisection. With a `hint` (the previous point's tilt: it changes little from point to
-/// point) the coarse steps start there, going down while clear or up while not, so that
-/// a clear tilt costs a few tests instead of a scan from zero.
+/// The least tilt (radians) along azimuth `phi` at which the tool is clear, to within
+/// [`TILT_RESOLUTION_DEG`]. From a `hint` (the previous point's tilt: it changes little from
+/// point to point) the search gallops down while clear or up while not, from a step of twice
+/// the resolution doubling up to [`TILT_STEP_UNITS`], then bisects the last step; so a tilt
+/// close to the hint costs three or four tests. Without a hint it starts from the vertical
+/// in steps of [`TILT_STEP_UNITS`] up to the largest allowed.
 pub(super) fn least_tilt(
     obs: &Clearance,
     (c, n): (&Point3, &Vector3),
@@ -469,44 +93,65 @@ pub(super) fn least_tilt(
     phi: f64,
     hint: Option<f64>,
 ) -> Option<f64> {
-    let max = opts.max_tilt_deg.to_radians();
-    let step = TILT_STEP_DEG.to_radians();
-    let clear = |t: f64| usable(obs, (c, n), &tilted(t, phi), opts);
+    // Tilts are whole multiples of the resolution (the largest tilt capping them), and the
+    // search counts in those units: which tilts are tried, and how many bisections, never
+    // hang on the rounding of a difference (the same plan natively and in wasm).
+    let max = opts.max_tilt_deg.max(0.0).to_radians();
+    let res = TILT_RESOLUTION_DEG.to_radians();
+    let top = (max / res).ceil() as i64;
+    let coarse = TILT_STEP_UNITS;
+    let tilt = |k: i64| (k as f64 * res).min(max);
+    let clear = |k: i64| usable(obs, (c, n), &tilted(tilt(k), phi), opts);
     // `hi` clear, `lo` not (or zero, where the vertical was found not clear).
-    let (mut lo, mut hi) = match hint.map(|h| h.max(step).min(max)) {
+    let (mut lo, mut hi) = match hint.map(|h| ((h / res).round() as i64).clamp(1, top.max(1))) {
         Some(h) if clear(h) => {
-            let mut hi = h;
+            let (mut hi, mut step) = (h, 2);
             loop {
-                let lo = (hi - step).max(0.0);
-                if lo <= 0.0 || !clear(lo) {
+                let lo = (hi - step).max(0);
+                if lo == 0 || !clear(lo) {
                     break (lo, hi);
                 }
                 hi = lo;
+                step = (2 * step).min(coarse);
             }
         }
-        start => {
-            let mut hi = start.map_or(step.min(max), |h| (h + step).min(max));
+        Some(h) => {
+            let (mut lo, mut step) = (h, 2);
+            loop {
+                if lo >= top {
+                    return None;
+                }
+                let hi = (lo + step).min(top);
+                if clear(hi) {
+                    break (lo, hi);
+                }
+                lo = hi;
+                step = (2 * step).min(coarse);
+            }
+        }
+        None => {
+            let mut hi = coarse.min(top);
             loop {
                 if clear(hi) {
                     break;
                 }
-                if hi >= max {
+                if hi >= top {
                     return None;
                 }
-                hi = (hi + step).min(max);
+                hi = (hi + coarse).min(top);
             }
-            ((hi - step).max(0.0), hi)
+            ((hi - coarse).max(0), hi)
         }
     };
-    for _ in 0..TILT_BISECTIONS {
-        let mid = 0.5 * (lo + hi);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
         if clear(mid) {
             hi = mid;
         } else {
             lo = mid;
         }
     }
-    Some(hi)
+    Some(tilt(hi))
 }
 
 /// A clear axis at `c`, continuing the previous point's lean: the least clear tilt along
@@ -588,8 +233,8 @@ pub struct AxisStats {
     /// still comes within the safety margin of the model (poses checked every
     /// `SWEEP_STEP_DEG` of turn).
     pub sweep_hits: usize,
-    /// That safety margin: the obstacle samples' gap (mm) by which shank and holder are
-    /// grown.
+    /// That safety margin: the tessellations' deviation from the surface (mm) by which
+    /// shank and holder are grown (the larger of the two).
     pub margin_mm: f64,
     /// The end of the first of those (ball centre, mm).
     pub first_sweep_hit: Option<Point3>,
@@ -635,8 +280,8 @@ pub(super) const BRIDGE_DEPTH: usize = 6;
 /// `s1`) that split a blocked turn into clear ones, or a turn larger than
 /// `max_axis_step_deg` into smaller ones: the midpoint of the chord with the halfway axis
 /// for a clear turn; for a blocked one, +Z if that is clear, else the halfway axis if
-/// clear, else the least tilt leaning from `a`'s; then each half likewise. False if some
-/// turn stays blocked.
+/// clear, else the least clear tilt on the halfway azimuth, else the least tilt leaning
+/// from `a`'s; then each half likewise. False if some turn stays blocked.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bridge(
     a: &Move,
@@ -660,9 +305,18 @@ pub(super) fn bridge(
     let n = (contact_normal(a) + contact_normal(b))
         .try_normalize(AXIS_MIN_NORM)
         .unwrap_or_else(|| contact_normal(b));
-    let halfway = (a.tool_axis + b.tool_axis)
-        .try_normalize(AXIS_MIN_NORM)
-        .filter(|x| within_tilt(x, opts) && usable(obs, (&cl, &n), x, opts));
+    let half = (a.tool_axis + b.tool_axis).try_normalize(AXIS_MIN_NORM);
+    // The halfway axis if clear; else the least clear tilt on its azimuth (the turn goes
+    // round what blocks the straight one, as a tool at the largest tilt turning its
+    // azimuth must).
+    let halfway = half
+        .filter(|x| within_tilt(x, opts) && usable(obs, (&cl, &n), x, opts))
+        .or_else(|| {
+            let x = half.filter(|x| x.z < 1.0 - VERTICAL_COS_SLACK)?;
+            let phi = x.y.atan2(x.x);
+            least_tilt(obs, (&cl, &n), opts, phi, Some(x.z.clamp(-1.0, 1.0).acos()))
+                .map(|t| tilted(t, phi))
+        });
     // Both halves through the pose with `axis` at the chord's midpoint.
     let halves = |axis: Vector3, out: &mut Vec<(Move, f64)>| {
         let mid = Move {

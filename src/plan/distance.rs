@@ -2,15 +2,15 @@
 //! exactly against a tessellation within a known tolerance of it, through a bounding-volume
 //! hierarchy of its triangles.
 //!
-//! Owns: the hierarchy and the segment–triangle distance. Must not: know what the segments
-//! are for (air moves, lifted points); callers add the tessellation's tolerance to their
-//! margins.
+//! Owns: the hierarchy, the segment–triangle distance and the cylinder–triangle test (the
+//! shank and holder). Must not: know what the segments or cylinders are for (air moves,
+//! lifted points, tool axes); callers add the tessellation's tolerance to their margins.
 
 use crate::geom::{Point3, Vector3};
 use crate::model::Model;
 
 /// Triangles per leaf of the hierarchy.
-const LEAF: usize = 4;
+const LEAF: usize = 8;
 
 /// A node: its box, and either two children or a range of triangles.
 #[derive(Debug, Clone, Copy)]
@@ -105,8 +105,8 @@ impl SurfaceDistance {
             first: 0,
             count: n as u32,
         });
-        let mut stack = vec![(0usize, 0usize, n)];
-        while let Some((node, a, b)) = stack.pop() {
+        let mut stack = vec![(0usize, 0usize, n, 0usize)];
+        while let Some((node, a, b, depth)) = stack.pop() {
             let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
             for &t in &order[a..b] {
                 for q in &self.tris[t as usize] {
@@ -123,14 +123,15 @@ impl SurfaceDistance {
                 self.nodes[node].count = (b - a) as u32;
                 continue;
             }
-            // Split at the median centre along the box's longest side.
-            let axis = (0..3)
-                .max_by(|&i, &j| (hi[i] - lo[i]).total_cmp(&(hi[j] - lo[j])))
-                .unwrap_or(0);
-            let mid = (a + b) / 2;
-            order[a..b].select_nth_unstable_by(mid - a, |&x, &y| {
-                centres[x as usize][axis].total_cmp(&centres[y as usize][axis])
-            });
+            // Beyond [`AREA_DEPTH`] halves at the median, so the depth stays bounded.
+            let mid = if depth < AREA_DEPTH {
+                a + split_by_area(&mut order[a..b], &centres, &self.tris)
+            } else {
+                let axis = (0..3)
+                    .max_by(|&i, &j| (hi[i] - lo[i]).total_cmp(&(hi[j] - lo[j])))
+                    .unwrap_or(0);
+                a + split_at_median(&mut order[a..b], &centres, axis)
+            };
             let left = self.nodes.len();
             for _ in 0..2 {
                 self.nodes.push(Node {
@@ -142,8 +143,8 @@ impl SurfaceDistance {
             }
             self.nodes[node].first = left as u32;
             self.nodes[node].count = 0;
-            stack.push((left, a, mid));
-            stack.push((left + 1, mid, b));
+            stack.push((left, a, mid, depth + 1));
+            stack.push((left + 1, mid, b, depth + 1));
         }
         // Leaves index the triangles in `order`: store them so.
         self.tris = order.iter().map(|&t| self.tris[t as usize]).collect();
@@ -174,6 +175,335 @@ impl SurfaceDistance {
         }
         false
     }
+
+    /// A point of a triangle inside the flat-ended cylinder of radius `rad` along unit
+    /// `axis` from `c + axis·a0` to `c + axis·a1`, if there is one (exact against the
+    /// triangles; callers grow the cylinder by [`Self::tolerance_mm`] for the surface).
+    pub fn cylinder_hit(
+        &self,
+        c: &Point3,
+        axis: &Vector3,
+        (a0, a1): (f64, f64),
+        rad: f64,
+    ) -> Option<Point3> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let cyl = Cylinder::new(c, axis, (a0, a1), rad);
+        let mut stack = [0u32; MAX_DEPTH];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = self.nodes[stack[top] as usize];
+            if !cyl.may_meet(&node.lo, &node.hi) {
+                continue;
+            }
+            if node.count == 0 {
+                stack[top] = node.first + 1;
+                stack[top + 1] = node.first;
+                top += 2;
+                continue;
+            }
+            let first = node.first as usize;
+            if let Some(p) = self.tris[first..first + node.count as usize]
+                .iter()
+                .find_map(|t| cyl.hit(t))
+            {
+                return Some(p);
+            }
+        }
+        None
+    }
+}
+
+/// Bins of the surface-area split.
+const AREA_BINS: usize = 16;
+
+/// Splits `order` (triangle indices) in two and returns the first part's length (neither
+/// part empty): binned by centre along the longest side of the centres' box, cut where the
+/// parts' box areas times their counts sum least (the surface-area heuristic: the likely cost
+/// of a query that reaches this node); at the median centre where the centres do not spread.
+fn split_by_area(order: &mut [u32], centres: &[Vector3], tris: &[[Point3; 3]]) -> usize {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &t in order.iter() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(centres[t as usize][k]);
+            hi[k] = hi[k].max(centres[t as usize][k]);
+        }
+    }
+    let axis = (0..3)
+        .max_by(|&i, &j| (hi[i] - lo[i]).total_cmp(&(hi[j] - lo[j])))
+        .unwrap_or(0);
+    let extent = hi[axis] - lo[axis];
+    let bin = |t: u32| {
+        (((centres[t as usize][axis] - lo[axis]) / extent * AREA_BINS as f64) as usize)
+            .min(AREA_BINS - 1)
+    };
+    let mut best = None;
+    if extent > 0.0 {
+        let mut boxes = [([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); AREA_BINS];
+        let mut counts = [0usize; AREA_BINS];
+        for &t in order.iter() {
+            let b = bin(t);
+            counts[b] += 1;
+            for q in &tris[t as usize] {
+                for k in 0..3 {
+                    boxes[b].0[k] = boxes[b].0[k].min(q[k]);
+                    boxes[b].1[k] = boxes[b].1[k].max(q[k]);
+                }
+            }
+        }
+        let area = |(l, h): &([f64; 3], [f64; 3])| {
+            let e = [0, 1, 2].map(|k| (h[k] - l[k]).max(0.0));
+            e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+        };
+        let merge = |x: &([f64; 3], [f64; 3]), y: &([f64; 3], [f64; 3])| {
+            (
+                [0, 1, 2].map(|k| x.0[k].min(y.0[k])),
+                [0, 1, 2].map(|k| x.1[k].max(y.1[k])),
+            )
+        };
+        // Cost of cutting after bin `i`, from the left and right sweeps.
+        let mut left = vec![(0.0, 0); AREA_BINS - 1];
+        let (mut acc, mut n) = (boxes[0], 0);
+        for i in 0..AREA_BINS - 1 {
+            acc = merge(&acc, &boxes[i]);
+            n += counts[i];
+            left[i] = (area(&acc), n);
+        }
+        let (mut acc, mut n) = (boxes[AREA_BINS - 1], 0);
+        let mut lowest = f64::INFINITY;
+        for i in (0..AREA_BINS - 1).rev() {
+            acc = merge(&acc, &boxes[i + 1]);
+            n += counts[i + 1];
+            let (la, ln) = left[i];
+            let cost = la * ln as f64 + area(&acc) * n as f64;
+            if ln > 0 && n > 0 && cost <= lowest {
+                lowest = cost;
+                best = Some(i);
+            }
+        }
+    }
+    match best {
+        Some(cut) => {
+            // Stable partition: the order within each part is kept.
+            let (first, second): (Vec<u32>, Vec<u32>) = order.iter().partition(|&&t| bin(t) <= cut);
+            let m = first.len();
+            order[..m].copy_from_slice(&first);
+            order[m..].copy_from_slice(&second);
+            m
+        }
+        None => split_at_median(order, centres, axis),
+    }
+}
+
+/// Splits `order` at its median centre along coordinate `axis`; returns the first half's
+/// length.
+fn split_at_median(order: &mut [u32], centres: &[Vector3], axis: usize) -> usize {
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&x, &y| {
+        centres[x as usize][axis].total_cmp(&centres[y as usize][axis])
+    });
+    mid
+}
+
+/// Depth to which nodes are split by area; below it, at the median (at most 32 levels more
+/// for 2³² triangles).
+const AREA_DEPTH: usize = 30;
+/// Deepest the hierarchy gets, and the query stack's size.
+const MAX_DEPTH: usize = AREA_DEPTH + 34;
+
+/// A flat-ended cylinder in its own frame: the axis through `c` along unit `axis`, `e1` and
+/// `e2` across it.
+struct Cylinder {
+    c: Point3,
+    axis: Vector3,
+    e1: Vector3,
+    e2: Vector3,
+    a0: f64,
+    a1: f64,
+    rad: f64,
+    /// The axis segment's start, and the reciprocals of its extent (infinite along a
+    /// coordinate it does not change).
+    p0: Point3,
+    inv: [f64; 3],
+}
+
+/// Most corners of a triangle clipped by two parallel planes.
+const CLIPPED: usize = 5;
+
+impl Cylinder {
+    fn new(c: &Point3, axis: &Vector3, (a0, a1): (f64, f64), rad: f64) -> Self {
+        let other = if axis.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
+        let e1 = axis.cross(&other).normalize();
+        let d = axis * (a1 - a0);
+        Cylinder {
+            p0: c + axis * a0,
+            inv: [0, 1, 2].map(|k| {
+                if d[k].abs() < f64::MIN_POSITIVE {
+                    f64::INFINITY
+                } else {
+                    1.0 / d[k]
+                }
+            }),
+            c: *c,
+            axis: *axis,
+            e2: axis.cross(&e1),
+            e1,
+            a0,
+            a1,
+            rad,
+        }
+    }
+
+    /// False if the box from `lo` to `hi` surely misses the cylinder: it lies beyond an end
+    /// plane, its bounding sphere is farther than `rad` from the axis, or the axis segment
+    /// misses the box grown by `rad`.
+    fn may_meet(&self, lo: &[f64; 3], hi: &[f64; 3]) -> bool {
+        let (mut mid, mut half, mut d2, mut r2) = (0.0, 0.0, 0.0, 0.0);
+        let mut d = [0.0; 3];
+        for k in 0..3 {
+            d[k] = 0.5 * (lo[k] + hi[k]) - self.c[k];
+            let e = 0.5 * (hi[k] - lo[k]);
+            mid += d[k] * self.axis[k];
+            half += e * self.axis[k].abs();
+            r2 += e * e;
+        }
+        if mid + half < self.a0 || mid - half > self.a1 {
+            return false;
+        }
+        for k in 0..3 {
+            let x = d[k] - mid * self.axis[k];
+            d2 += x * x;
+        }
+        // Within `rad` plus the box's half diagonal of the axis: d² ≤ (rad + √r2)².
+        let over = d2 - self.rad * self.rad - r2;
+        if over > 0.0 && over * over > 4.0 * self.rad * self.rad * r2 {
+            return false;
+        }
+        // The axis segment against the grown box, slab by slab.
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for k in 0..3 {
+            let (l, h) = (lo[k] - self.rad, hi[k] + self.rad);
+            if self.inv[k].is_infinite() {
+                if self.p0[k] < l || self.p0[k] > h {
+                    return false;
+                }
+                continue;
+            }
+            let (u, v) = (
+                (l - self.p0[k]) * self.inv[k],
+                (h - self.p0[k]) * self.inv[k],
+            );
+            t0 = t0.max(u.min(v));
+            t1 = t1.min(u.max(v));
+            if t0 > t1 {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// A point of triangle `t` inside the cylinder, if there is one: the triangle clipped to
+    /// the slab between the end planes, seen along the axis, comes within `rad` of it.
+    fn hit(&self, t: &[Point3; 3]) -> Option<Point3> {
+        // Corners as (along, across 1, across 2).
+        let q = t.map(|p| {
+            let d = p - self.c;
+            [d.dot(&self.axis), d.dot(&self.e1), d.dot(&self.e2)]
+        });
+        if q.iter().all(|v| v[0] < self.a0) || q.iter().all(|v| v[0] > self.a1) {
+            return None;
+        }
+        if q.iter().all(|v| v[1] > self.rad)
+            || q.iter().all(|v| v[1] < -self.rad)
+            || q.iter().all(|v| v[2] > self.rad)
+            || q.iter().all(|v| v[2] < -self.rad)
+        {
+            return None;
+        }
+        let mut poly = [[0.0; 3]; CLIPPED];
+        poly[..3].copy_from_slice(&q);
+        let mut n = 3;
+        n = clip(&mut poly, n, |v| v[0] - self.a0);
+        n = clip(&mut poly, n, |v| self.a1 - v[0]);
+        if n == 0 {
+            return None;
+        }
+        let at = |v: [f64; 3]| self.c + self.axis * v[0] + self.e1 * v[1] + self.e2 * v[2];
+        // The axis passes through the polygon (seen along it) when the origin is on the same
+        // side of every edge of a polygon with area.
+        let (mut pos, mut neg) = (false, false);
+        for i in 0..n {
+            let (u, v) = (poly[i], poly[(i + 1) % n]);
+            let cross = u[1] * v[2] - u[2] * v[1];
+            pos |= cross > 0.0;
+            neg |= cross < 0.0;
+        }
+        if pos != neg {
+            // Where the axis pierces it: in the fan triangle from the first corner that
+            // holds the origin, by barycentric weights.
+            let u = poly[0];
+            for i in 1..n - 1 {
+                let (v, w) = (poly[i], poly[i + 1]);
+                let cross = |p: [f64; 3], q: [f64; 3]| p[1] * q[2] - p[2] * q[1];
+                let area = cross(
+                    [0.0, v[1] - u[1], v[2] - u[2]],
+                    [0.0, w[1] - u[1], w[2] - u[2]],
+                );
+                if area == 0.0 {
+                    continue;
+                }
+                let (bu, bv, bw) = (cross(v, w) / area, cross(w, u) / area, cross(u, v) / area);
+                if bu >= 0.0 && bv >= 0.0 && bw >= 0.0 {
+                    return Some(at([u[0] * bu + v[0] * bv + w[0] * bw, 0.0, 0.0]));
+                }
+            }
+            // (Rounding left it on an edge: the edges' test below finds it.)
+        }
+        let rad2 = self.rad * self.rad;
+        (0..n).find_map(|i| {
+            let (u, v) = (poly[i], poly[(i + 1) % n]);
+            let (dx, dy) = (v[1] - u[1], v[2] - u[2]);
+            let len2 = dx * dx + dy * dy;
+            let s = if len2 > 0.0 {
+                (-(u[1] * dx + u[2] * dy) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let w = [0, 1, 2].map(|k| u[k] + (v[k] - u[k]) * s);
+            (w[1] * w[1] + w[2] * w[2] < rad2).then(|| at(w))
+        })
+    }
+}
+
+/// Clips the convex polygon `poly[..n]` to where `side` is not negative (Sutherland–Hodgman);
+/// returns the new corner count.
+fn clip(poly: &mut [[f64; 3]; CLIPPED], n: usize, side: impl Fn(&[f64; 3]) -> f64) -> usize {
+    if (0..n).all(|i| side(&poly[i]) >= 0.0) {
+        return n;
+    }
+    let mut out = [[0.0; 3]; CLIPPED];
+    let mut m = 0;
+    for i in 0..n {
+        let (u, v) = (poly[i], poly[(i + 1) % n]);
+        let (su, sv) = (side(&u), side(&v));
+        if su >= 0.0 && m < CLIPPED {
+            out[m] = u;
+            m += 1;
+        }
+        if (su >= 0.0) != (sv >= 0.0) && m < CLIPPED {
+            let s = su / (su - sv);
+            out[m] = [0, 1, 2].map(|k| u[k] + (v[k] - u[k]) * s);
+            m += 1;
+        }
+    }
+    *poly = out;
+    m
 }
 
 /// True if the segment comes within `grow` of the box (tested against the box grown by
@@ -355,5 +685,100 @@ mod tests {
             agree > 10,
             "some segments must come near the surface: {agree}"
         );
+    }
+
+    /// True if some point of a fine barycentric lattice on `t` lies inside the cylinder.
+    fn lattice_hit(cyl: &Cylinder, t: &[Point3; 3], n: usize) -> bool {
+        (0..=n).any(|i| {
+            (0..=n - i).any(|j| {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                let p = t[0] + (t[1] - t[0]) * x + (t[2] - t[0]) * y;
+                let d = p - cyl.c;
+                let along = d.dot(&cyl.axis);
+                along >= cyl.a0 && along <= cyl.a1 && (d - cyl.axis * along).norm() < cyl.rad
+            })
+        })
+    }
+
+    #[test]
+    fn cylinder_triangle_tests_agree_with_a_dense_lattice_of_the_triangle() {
+        // Random triangles and cylinders in a 4 mm box: a hit must return a point of the
+        // triangle inside the cylinder, and a lattice point inside must mean a hit.
+        let mut rnd = crate::testing::uniform(777u64);
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..3000 {
+            let mut p = || Point3::new(4.0 * rnd() - 2.0, 4.0 * rnd() - 2.0, 4.0 * rnd() - 2.0);
+            let t = [p(), p(), p()];
+            let c = p();
+            let axis = (p() - Point3::origin()).normalize();
+            let a0 = 2.0 * rnd() - 1.0;
+            let cyl = Cylinder::new(&c, &axis, (a0, a0 + 3.0 * rnd()), 0.05 + rnd());
+            match cyl.hit(&t) {
+                Some(q) => {
+                    hits += 1;
+                    let d = q - cyl.c;
+                    let along = d.dot(&axis);
+                    assert!(along >= cyl.a0 - 1e-9 && along <= cyl.a1 + 1e-9);
+                    assert!((d - axis * along).norm() <= cyl.rad + 1e-9);
+                    assert!(point_triangle_distance(&q, &t) < 1e-9);
+                }
+                None => {
+                    misses += 1;
+                    assert!(!lattice_hit(&cyl, &t, 60), "missed {t:?} {c} {axis}");
+                }
+            }
+        }
+        assert!(hits > 300 && misses > 300, "{hits} hits, {misses} misses");
+    }
+
+    #[test]
+    fn cylinder_triangle_tests_match_hand_computed_cases() {
+        let t = [
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(2.0, 0.0, 0.0),
+            Point3::new(0.0, 2.0, 0.0),
+        ];
+        let z = Vector3::z();
+        let cyl = |c: [f64; 3], axis: Vector3, ends: (f64, f64), rad: f64| {
+            Cylinder::new(&Point3::from(c), &axis, ends, rad).hit(&t)
+        };
+        // Standing on the triangle's inside, flat end on it: a hit.
+        assert!(cyl([0.5, 0.5, 0.0], z, (0.0, 1.0), 0.1).is_some());
+        // Lifted by 0.01 mm: the flat end clears it (a capsule would not).
+        assert!(cyl([0.5, 0.5, 0.0], z, (0.01, 1.0), 0.1).is_none());
+        // Upright beside the hypotenuse x + y = 2, 0.1 / √2 mm off: hit only when wider.
+        let off = 1.0 + 0.1;
+        assert!(cyl([off, off, 0.0], z, (-1.0, 1.0), 0.14).is_none());
+        assert!(cyl([off, off, 0.0], z, (-1.0, 1.0), 0.15).is_some());
+        // Lying along +X at height 0.5 above the triangle: its side touches at radius 0.5.
+        let x = Vector3::x();
+        assert!(cyl([-1.0, 0.5, 0.5], x, (0.0, 5.0), 0.49).is_none());
+        assert!(cyl([-1.0, 0.5, 0.5], x, (0.0, 5.0), 0.51).is_some());
+        // Ending before the triangle starts (x < 0): no hit however wide.
+        assert!(cyl([-3.0, 0.5, 0.0], x, (0.0, 2.9), 5.0).is_none());
+    }
+
+    #[test]
+    fn the_hierarchy_finds_the_cylinder_hits_brute_force_finds() {
+        let m = crate::model::samples::load_sample("keycap-convex").unwrap();
+        let dist = SurfaceDistance::new(&m, 0.01);
+        let bb = m.surface.bbox();
+        let mut rnd = crate::testing::uniform(4242u64);
+        let mut agree = 0;
+        for _ in 0..400 {
+            let c = Point3::new(
+                bb.min[0] + (bb.max[0] - bb.min[0]) * rnd(),
+                bb.min[1] + (bb.max[1] - bb.min[1]) * rnd(),
+                bb.min[2] + (bb.max[2] - bb.min[2]) * (1.5 * rnd() - 0.25),
+            );
+            let axis = Vector3::new(rnd() - 0.5, rnd() - 0.5, rnd()).normalize();
+            let ends = (2.0 * rnd(), 2.0 + 10.0 * rnd());
+            let rad = 0.1 + 3.0 * rnd();
+            let cyl = Cylinder::new(&c, &axis, ends, rad);
+            let brute = dist.tris.iter().any(|t| cyl.hit(t).is_some());
+            assert_eq!(dist.cylinder_hit(&c, &axis, ends, rad).is_some(), brute);
+            agree += brute as usize;
+        }
+        assert!(agree > 40 && agree < 360, "{agree} of 400 cylinders hit");
     }
 }

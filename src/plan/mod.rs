@@ -7,6 +7,7 @@
 pub mod air;
 pub mod axis;
 pub mod budget;
+pub mod clearance;
 pub mod compare;
 pub mod corners;
 pub mod distance;

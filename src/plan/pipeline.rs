@@ -13,7 +13,8 @@
 //! what to cut (the strategies do) or measure the result (that is `verify`'s).
 
 use super::air::{self, AirStats, Routed};
-use super::axis::{self, AxisStats, Clearance};
+use super::axis::{self, AxisStats};
+use super::clearance::Clearance;
 use super::distance::SurfaceDistance;
 use super::draft::{Draft, Footprint};
 use super::gouge::{self, GougeStats};

@@ -7,7 +7,8 @@
 //! Must not: decide which points are cut (that is [`super::axis::choose`]'s `why`), or
 //! move cut points (only tool axes change here).
 
-use super::axis::{self, Clearance};
+use super::axis;
+use super::clearance::Clearance;
 use super::reach::Why;
 use super::toolpath::Toolpath;
 use super::PlanOptions;
