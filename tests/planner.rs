@@ -661,7 +661,7 @@ fn the_tool_always_comes_from_the_side_the_surface_faces() {
 
 #[test]
 fn the_turning_tool_between_cut_points_stays_out_of_the_head() {
-    // The planner checks the poses between neighbouring cut points (every 2° of turn) with
+    // The planner checks the poses between neighbouring cut points (as close together as its margin needs) with
     // its own obstacle index. Here every turn between two cutting moves is checked again,
     // every 1°, against dense surface samples: the shank (above the flutes) and the holder
     // must not enter the part, except at turns the planner itself reports as blocked.

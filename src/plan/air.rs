@@ -167,8 +167,10 @@ pub fn route(
     let moves = &path.moves;
     // The cut each air move leaves (the first retract after a cut) or comes down to (the
     // rapid above the next cut, before its plunge), and the way found.
-    let legs: Vec<Option<AirLeg>> = (0..moves.len())
-        .map(|i| {
+    // Kept for the air moves only, by move index (a vector over every move would be
+    // as large as a fifth of the path).
+    let legs: Vec<(usize, AirLeg)> = (0..moves.len())
+        .filter_map(|i| {
             let m = moves[i];
             let (cut, leg) = match m.kind {
                 MoveKind::Retract if i > 0 && moves[i - 1].kind.on_surface() => {
@@ -180,12 +182,12 @@ pub fn route(
                 _ => return None,
             };
             let way = way_up(&sweep, &grown, &moves[cut], m.cl_point.z);
-            Some((cut, leg, way))
+            Some((i, (cut, leg, way)))
         })
         .collect();
     let mut leave_out: Vec<usize> = Vec::new();
-    for (i, leg) in legs.iter().enumerate() {
-        let Some((cut, leg, None)) = leg else {
+    for (i, leg) in &legs {
+        let (i, (cut, leg, None)) = (*i, leg) else {
             continue;
         };
         let (cut, leg) = (*cut, *leg);
@@ -221,7 +223,11 @@ pub fn route(
         let m = old.moves[i];
         let param = old.param(i);
         let mut push = |mv: Move| add(mv, param);
-        let Some((cut, leg, Some(way))) = &legs[i] else {
+        let Some((cut, leg, Some(way))) = legs
+            .binary_search_by_key(&i, |x| x.0)
+            .ok()
+            .map(|k| &legs[k].1)
+        else {
             push(m);
             return;
         };

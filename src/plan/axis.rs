@@ -130,17 +130,18 @@ pub(super) fn least_tilt(
             }
         }
         None => {
-            let mut hi = coarse.min(top);
+            // `lo`: the last tilt found blocked (the vertical at first).
+            let (mut lo, mut hi) = (0, coarse.min(top));
             loop {
                 if clear(hi) {
-                    break;
+                    break (lo, hi);
                 }
                 if hi >= top {
                     return None;
                 }
+                lo = hi;
                 hi = (hi + coarse).min(top);
             }
-            ((hi - coarse).max(0), hi)
         }
     };
     while hi - lo > 1 {
@@ -230,8 +231,8 @@ pub struct AxisStats {
     /// (where it was blocked or larger than `max_axis_step_deg`).
     pub bridged: usize,
     /// Moves between two cut points during which the turning tool's shank or holder
-    /// still comes within the safety margin of the model (poses checked every
-    /// `SWEEP_STEP_DEG` of turn).
+    /// still comes within the safety margin of the model (poses checked as close together
+    /// as the margin needs: [`Clearance::sweep_poses`]).
     pub sweep_hits: usize,
     /// That safety margin: the tessellations' deviation from the surface (mm) by which
     /// shank and holder are grown (the larger of the two).
@@ -243,18 +244,16 @@ pub struct AxisStats {
     pub spread: usize,
 }
 
-/// Turn of the tool axis between the poses checked while it turns from one cut point to
-/// the next (degrees).
-const SWEEP_STEP_DEG: f64 = 2.0;
-
 /// True if a pose between cut points `a` and `b` (ball centre and axis interpolated
-/// linearly, every [`SWEEP_STEP_DEG`] of turn and at most the samples' gap of travel apart)
-/// puts the shank or holder into the model.
+/// linearly, as close together as [`Clearance::sweep_poses`] needs for the grown cylinders
+/// of the checked poses to hold the tool in between) puts the shank or holder into the
+/// model.
 pub(super) fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool {
-    let step = SWEEP_STEP_DEG.to_radians();
-    let turn = a.tool_axis.angle(&b.tool_axis);
-    let travel = (b.cl_point - a.cl_point).norm();
-    let poses = ((turn / step).ceil() as usize).max((travel / obs.gap_mm()).ceil() as usize);
+    let poses = obs.sweep_poses(
+        (&a.cl_point, &a.tool_axis),
+        (&b.cl_point, &b.tool_axis),
+        opts,
+    );
     if poses <= 1 {
         return false;
     }
@@ -309,14 +308,15 @@ pub(super) fn bridge(
     // The halfway axis if clear; else the least clear tilt on its azimuth (the turn goes
     // round what blocks the straight one, as a tool at the largest tilt turning its
     // azimuth must).
-    let halfway = half
-        .filter(|x| within_tilt(x, opts) && usable(obs, (&cl, &n), x, opts))
-        .or_else(|| {
-            let x = half.filter(|x| x.z < 1.0 - VERTICAL_COS_SLACK)?;
-            let phi = x.y.atan2(x.x);
-            least_tilt(obs, (&cl, &n), opts, phi, Some(x.z.clamp(-1.0, 1.0).acos()))
-                .map(|t| tilted(t, phi))
-        });
+    let halfway = || {
+        half.filter(|x| within_tilt(x, opts) && usable(obs, (&cl, &n), x, opts))
+            .or_else(|| {
+                let x = half.filter(|x| x.z < 1.0 - VERTICAL_COS_SLACK)?;
+                let phi = x.y.atan2(x.x);
+                least_tilt(obs, (&cl, &n), opts, phi, Some(x.z.clamp(-1.0, 1.0).acos()))
+                    .map(|t| tilted(t, phi))
+            })
+    };
     // Both halves through the pose with `axis` at the chord's midpoint.
     let halves = |axis: Vector3, out: &mut Vec<(Move, f64)>| {
         let mid = Move {
@@ -332,20 +332,31 @@ pub(super) fn bridge(
         first && second
     };
     if !blocked {
-        // A clear turn that is only too large is halved along its way, or left whole where
-        // that is not clear: a split must never make a clear turn blocked.
-        let Some(axis) = halfway else {
+        // A clear turn that is only too large is split along its way, or left whole where
+        // that is not clear or does not make the largest turn smaller: a split must never
+        // make a clear turn blocked, nor larger.
+        let Some(axis) = halfway() else {
             return true;
         };
         let kept = out.len();
-        if !halves(axis, out) {
+        let clear = halves(axis, out);
+        let mut axes = std::iter::once(&a.tool_axis)
+            .chain(out[kept..].iter().map(|(m, _)| &m.tool_axis))
+            .chain(std::iter::once(&b.tool_axis));
+        let mut prev = axes.next().copied().unwrap_or(a.tool_axis);
+        let largest = axes.fold(0.0, |w: f64, x| {
+            let t = prev.angle(x);
+            prev = *x;
+            w.max(t)
+        });
+        if !clear || largest >= a.tool_axis.angle(&b.tool_axis) {
             out.truncate(kept);
         }
         return true;
     }
     let axis = match vertical_hit(obs, (&cl, &n), &cc, opts) {
         None => Some(Vector3::z()),
-        Some(h) => halfway.or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
+        Some(h) => halfway().or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
     };
     match axis {
         Some(axis) => halves(axis, out),

@@ -307,8 +307,8 @@ fn split_at_median(order: &mut [u32], centres: &[Vector3], axis: usize) -> usize
     mid
 }
 
-/// Depth to which nodes are split by area; below it, at the median (at most 32 levels more
-/// for 2³² triangles).
+/// Depth to which nodes are split by area; below it, at the median (at most 30 levels more
+/// for 2³² triangles, eight a leaf).
 const AREA_DEPTH: usize = 30;
 /// Deepest the hierarchy gets, and the query stack's size.
 const MAX_DEPTH: usize = AREA_DEPTH + 34;
@@ -445,8 +445,12 @@ impl Cylinder {
             neg |= cross < 0.0;
         }
         if pos != neg {
-            // Where the axis pierces it: in the fan triangle from the first corner that
-            // holds the origin, by barycentric weights.
+            // Where the axis pierces it (in the fan triangle from the first corner that holds
+            // it, by barycentric weights; the corners' mean height where rounding leaves it in
+            // none), moved towards the polygon's middle by up to half the radius: a point of
+            // the triangle inside the cylinder that also says on which side the triangle lies
+            // (the tool leans away from it).
+            let mut along = poly[..n].iter().map(|v| v[0]).sum::<f64>() / n as f64;
             let u = poly[0];
             for i in 1..n - 1 {
                 let (v, w) = (poly[i], poly[i + 1]);
@@ -460,10 +464,25 @@ impl Cylinder {
                 }
                 let (bu, bv, bw) = (cross(v, w) / area, cross(w, u) / area, cross(u, v) / area);
                 if bu >= 0.0 && bv >= 0.0 && bw >= 0.0 {
-                    return Some(at([u[0] * bu + v[0] * bv + w[0] * bw, 0.0, 0.0]));
+                    along = u[0] * bu + v[0] * bv + w[0] * bw;
+                    break;
                 }
             }
-            // (Rounding left it on an edge: the edges' test below finds it.)
+            let mean = poly[..n]
+                .iter()
+                .fold([0.0; 3], |s, v| [s[0] + v[0], s[1] + v[1], s[2] + v[2]])
+                .map(|x| x / n as f64);
+            let off = (mean[1] * mean[1] + mean[2] * mean[2]).sqrt();
+            let t = if off > 0.5 * self.rad {
+                0.5 * self.rad / off
+            } else {
+                1.0
+            };
+            return Some(at([
+                along + (mean[0] - along) * t,
+                mean[1] * t,
+                mean[2] * t,
+            ]));
         }
         let rad2 = self.rad * self.rad;
         (0..n).find_map(|i| {

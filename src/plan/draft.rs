@@ -211,6 +211,10 @@ impl DraftBuilder {
         forced_retractions: usize,
     ) -> Draft {
         self.retract();
+        // Grown by doubling: give back the unused half.
+        self.moves.shrink_to_fit();
+        self.params.shrink_to_fit();
+        self.footprints.shrink_to_fit();
         Draft {
             strategy,
             toolpath: Toolpath {

@@ -87,12 +87,22 @@ pub struct Rest {
 pub fn split(draft: &Draft, skip: &[Option<Why>]) -> (Toolpath, Vec<u32>) {
     let old = &draft.toolpath;
     let n = old.moves.len();
+    // Each cut kept costs at most three moves more (retract, rapid, plunge): room for them
+    // all, so the vectors never double.
+    let cuts = (0..n)
+        .filter(|&i| {
+            let kept = |i: usize| old.moves[i].kind.on_surface() && skip[i].is_none();
+            kept(i) && (i == 0 || !kept(i - 1))
+        })
+        .count();
+    let room = n + 3 * cuts + 2;
+    let has_params = old.params.len() == n;
     let mut out = Emitted {
-        has_params: old.params.len() == n,
+        has_params,
         safe_z: draft.safe_z,
-        moves: Vec::with_capacity(n),
-        params: Vec::with_capacity(n),
-        origin: Vec::with_capacity(n),
+        moves: Vec::with_capacity(room),
+        params: Vec::with_capacity(if has_params { room } else { 0 }),
+        origin: Vec::with_capacity(room),
     };
     // Whether the tool is on the surface at the last move emitted and may go on from there.
     let mut joined = false;
@@ -151,7 +161,9 @@ struct Emitted {
 impl Emitted {
     fn push(&mut self, m: Move, q: [f64; 2], origin: u32) {
         self.moves.push(m);
-        self.params.push(q);
+        if self.has_params {
+            self.params.push(q);
+        }
         self.origin.push(origin);
     }
 

@@ -299,6 +299,10 @@ impl PlanReport {
     }
 }
 
+/// A rebuilt path's vectors start with room for this fraction (one in so many) more moves
+/// than the old path.
+const REBUILD_ROOM: usize = 16;
+
 impl Toolpath {
     /// Rebuilds the moves: `f(old, i, add)` adds, through `add(move, params)`, the moves
     /// that replace old move `i` (`old` holds the old moves and their params, the latter
@@ -317,8 +321,11 @@ impl Toolpath {
             moves: &old_moves,
             params: &old_params,
         };
-        let mut moves: Vec<Move> = Vec::with_capacity(n);
-        let mut params: Vec<[f64; 2]> = Vec::with_capacity(self.params.len());
+        // Room for a few added moves (the bridging adds some per cent at most): a vector
+        // grown past its capacity doubles, and the path is the plan's largest allocation.
+        let room = n + n / REBUILD_ROOM + 16;
+        let mut moves: Vec<Move> = Vec::with_capacity(room);
+        let mut params: Vec<[f64; 2]> = Vec::with_capacity(if has_params { room } else { 0 });
         // First and last new index of each old move.
         let mut new_index = vec![(0usize, 0usize); n];
         for (i, slot) in new_index.iter_mut().enumerate() {
@@ -338,6 +345,10 @@ impl Toolpath {
                 run.last_move = new_index[run.last_move].1;
             }
         }
+        drop(old_moves);
+        drop(old_params);
+        moves.shrink_to_fit();
+        params.shrink_to_fit();
         self.moves = moves;
         if has_params {
             self.params = params;
