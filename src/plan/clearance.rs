@@ -181,6 +181,37 @@ fn grown_hit(
 mod tests {
     use super::*;
 
+    /// A pose: ball centre and unit axis.
+    type Pose = (Point3, Vector3);
+
+    /// Calls `f` with every sampled point of a cylinder of radius `rad` (at `heights` above
+    /// the ball centre, 24 round) at poses in between the `count` checked ones of the move
+    /// `pose(0) → pose(1)`, and the two checked poses either side.
+    fn points_between(
+        pose: &dyn Fn(f64) -> Pose,
+        count: usize,
+        heights: &[f64],
+        rad: f64,
+        f: &mut dyn FnMut(&Point3, &[Pose; 2]),
+    ) {
+        for k in 0..count {
+            let (s0, s1) = (k as f64 / count as f64, (k + 1) as f64 / count as f64);
+            let ends = [pose(s0), pose(s1)];
+            for i in 1..12 {
+                let (c, axis) = pose(s0 + (s1 - s0) * i as f64 / 12.0);
+                let side = axis.cross(&Vector3::y()).normalize();
+                let across = [side, axis.cross(&side)];
+                for &h in heights {
+                    for q in 0..24 {
+                        let w = std::f64::consts::TAU * q as f64 / 24.0;
+                        let p = c + axis * h + (across[0] * w.cos() + across[1] * w.sin()) * rad;
+                        f(&p, &ends);
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn the_tool_between_checked_poses_stays_inside_their_grown_cylinders() {
         // A shank of radius 0.5 mm up to 20 mm grown by 0.025 mm: random moves split into
@@ -212,34 +243,19 @@ mod tests {
                     Vector3::new(a.sin(), 0.0, a.cos()),
                 )
             };
+            let heights: Vec<f64> = (0..16).map(|j| top * j as f64 / 15.0).collect();
             let worst = |count: usize| {
                 let mut worst: f64 = 0.0;
-                for k in 0..count {
-                    let (s0, s1) = (k as f64 / count as f64, (k + 1) as f64 / count as f64);
-                    let ends = [pose(s0), pose(s1)];
-                    for i in 1..16 {
-                        let (c, axis) = pose(s0 + (s1 - s0) * i as f64 / 16.0);
-                        let side = axis.cross(&Vector3::y()).normalize();
-                        let across = [side, axis.cross(&side)];
-                        for j in 0..16 {
-                            let h = top * j as f64 / 15.0;
-                            for q in 0..12 {
-                                let w = std::f64::consts::TAU * q as f64 / 12.0;
-                                let p = c
-                                    + axis * h
-                                    + (across[0] * w.cos() + across[1] * w.sin()) * rad;
-                                let nearest = ends
-                                    .iter()
-                                    .map(|(e, a)| {
-                                        let d = p - e;
-                                        (d - a * d.dot(a)).norm()
-                                    })
-                                    .fold(f64::INFINITY, f64::min);
-                                worst = worst.max(nearest);
-                            }
-                        }
-                    }
-                }
+                points_between(&pose, count, &heights, rad, &mut |p, ends| {
+                    let nearest = ends
+                        .iter()
+                        .map(|(e, a)| {
+                            let d = p - e;
+                            (d - a * d.dot(a)).norm()
+                        })
+                        .fold(f64::INFINITY, f64::min);
+                    worst = worst.max(nearest);
+                });
                 worst
             };
             assert!(
@@ -295,26 +311,13 @@ mod tests {
                 // Above the holder's top nothing is checked (the spindle is not modelled).
                 h >= bottom - g - 1e-9 && (d - a * h).norm() <= rad + g + 1e-9
             };
-            for k in 0..poses {
-                let (s0, s1) = (k as f64 / poses as f64, (k + 1) as f64 / poses as f64);
-                let ends = [pose(s0), pose(s1)];
-                for i in 1..12 {
-                    let (c, axis) = pose(s0 + (s1 - s0) * i as f64 / 12.0);
-                    let side = axis.cross(&Vector3::y()).normalize();
-                    let across = [side, axis.cross(&side)];
-                    for h in [bottom, bottom + 0.5, 0.5 * (bottom + top), top] {
-                        for q in 0..24 {
-                            let w = std::f64::consts::TAU * q as f64 / 24.0;
-                            let p =
-                                c + axis * h + (across[0] * w.cos() + across[1] * w.sin()) * rad;
-                            assert!(
-                                ends.iter().any(|e| inside(&p, e)),
-                                "travel {travel:.3} rise {rise:.3} turn {turn:.4}: {poses} poses leave {p}"
-                            );
-                        }
-                    }
-                }
-            }
+            let heights = [bottom, bottom + 0.5, 0.5 * (bottom + top), top];
+            points_between(&pose, poses, &heights, rad, &mut |p, ends| {
+                assert!(
+                    ends.iter().any(|e| inside(p, e)),
+                    "travel {travel:.3} rise {rise:.3} turn {turn:.4}: {poses} poses leave {p}"
+                );
+            });
         }
     }
 }

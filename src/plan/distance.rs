@@ -111,8 +111,8 @@ impl SurfaceDistance {
             for &t in &order[a..b] {
                 for q in &self.tris[t as usize] {
                     for k in 0..3 {
-                        lo[k] = lo[k].min(q[k]);
-                        hi[k] = hi[k].max(q[k]);
+                        lo[k] = least(lo[k], q[k]);
+                        hi[k] = most(hi[k], q[k]);
                     }
                 }
             }
@@ -216,6 +216,27 @@ impl SurfaceDistance {
     }
 }
 
+/// The smaller of two numbers that are not NaN, by a plain comparison (`f64::min` is a call
+/// in wasm, for its NaN rule; the hierarchy's build and queries take millions).
+#[inline]
+fn least(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The larger of two numbers that are not NaN (see [`least`]).
+#[inline]
+fn most(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 /// Bins of the surface-area split.
 const AREA_BINS: usize = 16;
 
@@ -227,8 +248,8 @@ fn split_by_area(order: &mut [u32], centres: &[Vector3], tris: &[[Point3; 3]]) -
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for &t in order.iter() {
         for k in 0..3 {
-            lo[k] = lo[k].min(centres[t as usize][k]);
-            hi[k] = hi[k].max(centres[t as usize][k]);
+            lo[k] = least(lo[k], centres[t as usize][k]);
+            hi[k] = most(hi[k], centres[t as usize][k]);
         }
     }
     let axis = (0..3)
@@ -248,8 +269,8 @@ fn split_by_area(order: &mut [u32], centres: &[Vector3], tris: &[[Point3; 3]]) -
             counts[b] += 1;
             for q in &tris[t as usize] {
                 for k in 0..3 {
-                    boxes[b].0[k] = boxes[b].0[k].min(q[k]);
-                    boxes[b].1[k] = boxes[b].1[k].max(q[k]);
+                    boxes[b].0[k] = least(boxes[b].0[k], q[k]);
+                    boxes[b].1[k] = most(boxes[b].1[k], q[k]);
                 }
             }
         }
@@ -259,8 +280,8 @@ fn split_by_area(order: &mut [u32], centres: &[Vector3], tris: &[[Point3; 3]]) -
         };
         let merge = |x: &([f64; 3], [f64; 3]), y: &([f64; 3], [f64; 3])| {
             (
-                [0, 1, 2].map(|k| x.0[k].min(y.0[k])),
-                [0, 1, 2].map(|k| x.1[k].max(y.1[k])),
+                [0, 1, 2].map(|k| least(x.0[k], y.0[k])),
+                [0, 1, 2].map(|k| most(x.1[k], y.1[k])),
             )
         };
         // Cost of cutting after bin `i`, from the left and right sweeps.
@@ -399,8 +420,8 @@ impl Cylinder {
                 (l - self.p0[k]) * self.inv[k],
                 (h - self.p0[k]) * self.inv[k],
             );
-            t0 = t0.max(u.min(v));
-            t1 = t1.min(u.max(v));
+            t0 = most(t0, least(u, v));
+            t1 = least(t1, most(u, v));
             if t0 > t1 {
                 return false;
             }
@@ -542,8 +563,8 @@ fn segment_meets_box(a: &Point3, b: &Point3, lo: &[f64; 3], hi: &[f64; 3], grow:
         if u > v {
             std::mem::swap(&mut u, &mut v);
         }
-        t0 = t0.max(u);
-        t1 = t1.min(v);
+        t0 = most(t0, u);
+        t1 = least(t1, v);
         if t0 > t1 {
             return false;
         }
