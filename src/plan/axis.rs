@@ -99,7 +99,6 @@ pub(super) fn least_tilt(
     let max = opts.max_tilt_deg.max(0.0).to_radians();
     let res = TILT_RESOLUTION_DEG.to_radians();
     let top = (max / res).ceil() as i64;
-    let coarse = TILT_STEP_UNITS;
     let tilt = |k: i64| (k as f64 * res).min(max);
     let clear = |k: i64| usable(obs, (c, n), &tilted(tilt(k), phi), opts);
     // `hi` clear, `lo` not (or zero, where the vertical was found not clear).
@@ -112,7 +111,7 @@ pub(super) fn least_tilt(
                     break (lo, hi);
                 }
                 hi = lo;
-                step = (2 * step).min(coarse);
+                step = (2 * step).min(TILT_STEP_UNITS);
             }
         }
         Some(h) => {
@@ -126,12 +125,12 @@ pub(super) fn least_tilt(
                     break (lo, hi);
                 }
                 lo = hi;
-                step = (2 * step).min(coarse);
+                step = (2 * step).min(TILT_STEP_UNITS);
             }
         }
         None => {
             // `lo`: the last tilt found blocked (the vertical at first).
-            let (mut lo, mut hi) = (0, coarse.min(top));
+            let (mut lo, mut hi) = (0, TILT_STEP_UNITS.min(top));
             loop {
                 if clear(hi) {
                     break (lo, hi);
@@ -140,7 +139,7 @@ pub(super) fn least_tilt(
                     return None;
                 }
                 lo = hi;
-                hi = (hi + coarse).min(top);
+                hi = (hi + TILT_STEP_UNITS).min(top);
             }
         }
     };
@@ -340,15 +339,14 @@ pub(super) fn bridge(
         };
         let kept = out.len();
         let clear = halves(axis, out);
-        let mut axes = std::iter::once(&a.tool_axis)
-            .chain(out[kept..].iter().map(|(m, _)| &m.tool_axis))
-            .chain(std::iter::once(&b.tool_axis));
-        let mut prev = axes.next().copied().unwrap_or(a.tool_axis);
-        let largest = axes.fold(0.0, |w: f64, x| {
-            let t = prev.angle(x);
-            prev = *x;
-            w.max(t)
-        });
+        let axes: Vec<Vector3> = std::iter::once(a.tool_axis)
+            .chain(out[kept..].iter().map(|(m, _)| m.tool_axis))
+            .chain(std::iter::once(b.tool_axis))
+            .collect();
+        let largest = axes
+            .windows(2)
+            .map(|w| w[0].angle(&w[1]))
+            .fold(0.0, f64::max);
         if !clear || largest >= a.tool_axis.angle(&b.tool_axis) {
             out.truncate(kept);
         }

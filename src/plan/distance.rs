@@ -155,10 +155,11 @@ impl SurfaceDistance {
         if self.nodes.is_empty() {
             return false;
         }
+        let probe = BoxProbe::new(a, b);
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {
             let node = self.nodes[i];
-            if !segment_meets_box(a, b, &node.lo, &node.hi, limit) {
+            if !probe.meets(&node.lo, &node.hi, limit) {
                 continue;
             }
             if node.count == 0 {
@@ -344,10 +345,8 @@ struct Cylinder {
     a0: f64,
     a1: f64,
     rad: f64,
-    /// The axis segment's start, and the reciprocals of its extent (infinite along a
-    /// coordinate it does not change).
-    p0: Point3,
-    inv: [f64; 3],
+    /// The axis segment from `c + axis·a0` to `c + axis·a1`, for box tests.
+    axis_probe: BoxProbe,
 }
 
 /// Most corners of a triangle clipped by two parallel planes.
@@ -361,16 +360,8 @@ impl Cylinder {
             Vector3::y()
         };
         let e1 = axis.cross(&other).normalize();
-        let d = axis * (a1 - a0);
         Cylinder {
-            p0: c + axis * a0,
-            inv: [0, 1, 2].map(|k| {
-                if d[k].abs() < f64::MIN_POSITIVE {
-                    f64::INFINITY
-                } else {
-                    1.0 / d[k]
-                }
-            }),
+            axis_probe: BoxProbe::new(&(c + axis * a0), &(c + axis * a1)),
             c: *c,
             axis: *axis,
             e2: axis.cross(&e1),
@@ -406,27 +397,8 @@ impl Cylinder {
         if over > 0.0 && over * over > 4.0 * self.rad * self.rad * r2 {
             return false;
         }
-        // The axis segment against the grown box, slab by slab.
-        let (mut t0, mut t1) = (0.0f64, 1.0f64);
-        for k in 0..3 {
-            let (l, h) = (lo[k] - self.rad, hi[k] + self.rad);
-            if self.inv[k].is_infinite() {
-                if self.p0[k] < l || self.p0[k] > h {
-                    return false;
-                }
-                continue;
-            }
-            let (u, v) = (
-                (l - self.p0[k]) * self.inv[k],
-                (h - self.p0[k]) * self.inv[k],
-            );
-            t0 = most(t0, least(u, v));
-            t1 = least(t1, most(u, v));
-            if t0 > t1 {
-                return false;
-            }
-        }
-        true
+        // The axis segment against the box grown by the radius.
+        self.axis_probe.meets(lo, hi, self.rad)
     }
 
     /// A point of triangle `t` inside the cylinder, if there is one: the triangle clipped to
@@ -546,30 +518,50 @@ fn clip(poly: &mut [[f64; 3]; CLIPPED], n: usize, side: impl Fn(&[f64; 3]) -> f6
     m
 }
 
-/// True if the segment comes within `grow` of the box (tested against the box grown by
-/// `grow` on every side, which contains that neighbourhood).
-fn segment_meets_box(a: &Point3, b: &Point3, lo: &[f64; 3], hi: &[f64; 3], grow: f64) -> bool {
-    let d = b - a;
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for k in 0..3 {
-        let (l, h) = (lo[k] - grow, hi[k] + grow);
-        if d[k].abs() < f64::MIN_POSITIVE {
-            if a[k] < l || a[k] > h {
-                return false;
-            }
-            continue;
-        }
-        let (mut u, mut v) = ((l - a[k]) / d[k], (h - a[k]) / d[k]);
-        if u > v {
-            std::mem::swap(&mut u, &mut v);
-        }
-        t0 = most(t0, u);
-        t1 = least(t1, v);
-        if t0 > t1 {
-            return false;
+/// A segment set up for many box tests: its start and the reciprocals of its extent
+/// (infinite along a coordinate it does not change), so a test multiplies instead of
+/// dividing.
+struct BoxProbe {
+    a: Point3,
+    inv: [f64; 3],
+}
+
+impl BoxProbe {
+    fn new(a: &Point3, b: &Point3) -> Self {
+        let d = b - a;
+        BoxProbe {
+            a: *a,
+            inv: [0, 1, 2].map(|k| {
+                if d[k].abs() < f64::MIN_POSITIVE {
+                    f64::INFINITY
+                } else {
+                    1.0 / d[k]
+                }
+            }),
         }
     }
-    true
+
+    /// True if the segment comes within `grow` of the box (tested against the box grown by
+    /// `grow` on every side, which contains that neighbourhood).
+    fn meets(&self, lo: &[f64; 3], hi: &[f64; 3], grow: f64) -> bool {
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for k in 0..3 {
+            let (l, h) = (lo[k] - grow, hi[k] + grow);
+            if self.inv[k].is_infinite() {
+                if self.a[k] < l || self.a[k] > h {
+                    return false;
+                }
+                continue;
+            }
+            let (u, v) = ((l - self.a[k]) * self.inv[k], (h - self.a[k]) * self.inv[k]);
+            t0 = most(t0, least(u, v));
+            t1 = least(t1, most(u, v));
+            if t0 > t1 {
+                return false;
+            }
+        }
+        true
+    }
 }
 
 /// Distance between point `p` and triangle `t`.
@@ -697,6 +689,16 @@ mod tests {
         assert!((d([1.0, -1.0, 1.0], [1.0, -3.0, 1.0]) - 2f64.sqrt()).abs() < 1e-14);
     }
 
+    /// A random point over the box's footprint, from a quarter of its height below it to a
+    /// quarter above.
+    fn around(bb: &crate::geom::Aabb, r: &mut dyn FnMut() -> f64) -> Point3 {
+        Point3::new(
+            bb.min[0] + (bb.max[0] - bb.min[0]) * r(),
+            bb.min[1] + (bb.max[1] - bb.min[1]) * r(),
+            bb.min[2] + (bb.max[2] - bb.min[2]) * (1.5 * r() - 0.25),
+        )
+    }
+
     #[test]
     fn the_hierarchy_finds_what_brute_force_finds() {
         let m = crate::model::samples::load_sample("keycap-convex").unwrap();
@@ -705,14 +707,7 @@ mod tests {
         let mut rnd = crate::testing::uniform(12345u64);
         let mut agree = 0;
         for _ in 0..200 {
-            let p = |r: &mut dyn FnMut() -> f64| {
-                Point3::new(
-                    bb.min[0] + (bb.max[0] - bb.min[0]) * r(),
-                    bb.min[1] + (bb.max[1] - bb.min[1]) * r(),
-                    bb.min[2] + (bb.max[2] - bb.min[2]) * (1.5 * r() - 0.25),
-                )
-            };
-            let (a, b) = (p(&mut rnd), p(&mut rnd));
+            let (a, b) = (around(&bb, &mut rnd), around(&bb, &mut rnd));
             let limit = 0.5 * rnd();
             let brute = dist
                 .tris
@@ -806,11 +801,7 @@ mod tests {
         let mut rnd = crate::testing::uniform(4242u64);
         let mut agree = 0;
         for _ in 0..400 {
-            let c = Point3::new(
-                bb.min[0] + (bb.max[0] - bb.min[0]) * rnd(),
-                bb.min[1] + (bb.max[1] - bb.min[1]) * rnd(),
-                bb.min[2] + (bb.max[2] - bb.min[2]) * (1.5 * rnd() - 0.25),
-            );
+            let c = around(&bb, &mut rnd);
             let axis = Vector3::new(rnd() - 0.5, rnd() - 0.5, rnd()).normalize();
             let ends = (2.0 * rnd(), 2.0 + 10.0 * rnd());
             let rad = 0.1 + 3.0 * rnd();

@@ -89,11 +89,9 @@ pub fn split(draft: &Draft, skip: &[Option<Why>]) -> (Toolpath, Vec<u32>) {
     let n = old.moves.len();
     // Each cut kept costs at most three moves more (retract, rapid, plunge): room for them
     // all, so the vectors never double.
+    let kept = |i: usize| old.moves[i].kind.on_surface() && skip[i].is_none();
     let cuts = (0..n)
-        .filter(|&i| {
-            let kept = |i: usize| old.moves[i].kind.on_surface() && skip[i].is_none();
-            kept(i) && (i == 0 || !kept(i - 1))
-        })
+        .filter(|&i| kept(i) && (i == 0 || !kept(i - 1)))
         .count();
     let room = n + 3 * cuts + 2;
     let has_params = old.params.len() == n;
