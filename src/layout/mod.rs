@@ -731,14 +731,7 @@ impl Patch {
         let (p, [x, y]) = self.locate(u * self.width, v * self.height);
         let face = &surface.faces()[p.face as usize];
         let d = face.derivs(x / face.width, y / face.height);
-        // (a, b) face parameters from (u, v): a = x / W_f with (x, y) = rot(-k)(s - off),
-        // s = u·W, t = v·H.
-        let m = rot((4 - p.quarter_turns) % 4, [1.0, 0.0]);
-        let n = rot((4 - p.quarter_turns) % 4, [0.0, 1.0]);
-        let j00 = m[0] * self.width / face.width;
-        let j10 = m[1] * self.width / face.height;
-        let j01 = n[0] * self.height / face.width;
-        let j11 = n[1] * self.height / face.height;
+        let [j00, j10, j01, j11] = self.jacobian(p, face);
         SurfaceDerivs {
             point: d.point,
             su: d.su * j00 + d.sv * j10,
@@ -747,6 +740,35 @@ impl Patch {
             suv: d.suu * (j00 * j01) + d.suv * (j00 * j11 + j10 * j01) + d.svv * (j10 * j11),
             svv: d.suu * (j01 * j01) + d.suv * (2.0 * j01 * j11) + d.svv * (j11 * j11),
         }
+    }
+
+    /// Point and first derivatives `(S, S_u, S_v)` at patch parameters `(u, v)`: those of
+    /// [`Patch::derivs`], without the second derivatives.
+    pub fn first_derivs(
+        &self,
+        surface: &Surface,
+        u: f64,
+        v: f64,
+    ) -> (Point3, crate::geom::Vector3, crate::geom::Vector3) {
+        let (p, [x, y]) = self.locate(u * self.width, v * self.height);
+        let face = &surface.faces()[p.face as usize];
+        let (point, su, sv) = face.first_derivs(x / face.width, y / face.height);
+        let [j00, j10, j01, j11] = self.jacobian(p, face);
+        (point, su * j00 + sv * j10, su * j01 + sv * j11)
+    }
+
+    /// `∂(a, b)/∂(u, v)` as `[∂a/∂u, ∂b/∂u, ∂a/∂v, ∂b/∂v]`: face parameters `(a, b)` of
+    /// piece `p` from patch parameters, `a = x / W_f` with `(x, y) = rot(−k)(s − off)`,
+    /// `s = u·W`, `t = v·H`.
+    fn jacobian(&self, p: &Piece, face: &crate::surface::FaceSurface) -> [f64; 4] {
+        let m = rot((4 - p.quarter_turns) % 4, [1.0, 0.0]);
+        let n = rot((4 - p.quarter_turns) % 4, [0.0, 1.0]);
+        [
+            m[0] * self.width / face.width,
+            m[1] * self.width / face.height,
+            n[0] * self.height / face.width,
+            n[1] * self.height / face.height,
+        ]
     }
 
     /// Unit normal at patch parameters `(u, v)` (from nearby where the surface is singular).

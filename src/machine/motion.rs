@@ -37,6 +37,9 @@ const S_PER_MIN: f64 = 60.0;
 const NULL_MOVE: f64 = 1e-12;
 /// Bisection steps of the speed searches (the interval halves each step).
 const BISECTION_STEPS: usize = 60;
+/// Most Newton steps of [`reach`]'s cubic (it converges in a few from its start; from a
+/// start far above a tiny root each step shrinks the root's bracket by at least a third).
+const NEWTON_STEPS: usize = 200;
 
 /// What limits a machine's motion. Fields default to a mid-size machining centre.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -184,21 +187,39 @@ fn change(a: f64, b: f64, accel: f64, jerk: f64) -> (f64, f64) {
     (t, 0.5 * (a + b) * t)
 }
 
-/// The highest speed reachable from `from` within `p` (never above `cap`).
+/// The highest speed reachable from `from` within `p` (never above `cap`): the speed change
+/// `x` whose S-curve ([`change`]) covers exactly `p`, in closed form where the curve has a
+/// constant-acceleration part (a quadratic in `x`) and by Newton's method where it has not
+/// (`j s³ + 2·from·s = p` with `x = j s²`).
 fn reach(from: f64, p: f64, cap: f64, accel: f64, jerk: f64) -> f64 {
     if cap <= from || change(from, cap, accel, jerk).1 <= p {
         return cap;
     }
-    let (mut lo, mut hi) = (from, cap);
-    for _ in 0..BISECTION_STEPS {
-        let mid = 0.5 * (lo + hi);
-        if change(from, mid, accel, jerk).1 <= p {
-            lo = mid;
-        } else {
-            hi = mid;
+    // x² + b x − c = 0 (c ≥ 0): the positive root, in the form without cancellation.
+    let root = |b: f64, c: f64| 2.0 * c / (b + (b * b + 4.0 * c).sqrt());
+    let x = if !jerk.is_finite() {
+        // p = (from + x/2) x / a.
+        root(2.0 * from, 2.0 * accel * p)
+    } else if change(from, from + accel * accel / jerk, accel, jerk).1 <= p {
+        // p = (from + x/2)(x/a + a/j).
+        let t = accel * accel / jerk;
+        root(2.0 * from + t, 2.0 * accel * (p - from * accel / jerk))
+    } else {
+        // p = (from + j s²/2) 2 s: convex and increasing in s ≥ 0, so Newton's method from
+        // s = a/j (where the constant-acceleration part would begin, beyond the root) falls
+        // to the root monotonically; it stops when a step no longer shrinks s.
+        let f = |s: f64| jerk * s * s * s + 2.0 * from * s - p;
+        let mut s = accel / jerk;
+        for _ in 0..NEWTON_STEPS {
+            let next = s - f(s) / (3.0 * jerk * s * s + 2.0 * from);
+            if !(next < s) {
+                break;
+            }
+            s = next.max(0.0);
         }
-    }
-    lo
+        jerk * s * s
+    };
+    (from + x).min(cap)
 }
 
 /// Time (s) of one move entered at `v0` and left at `v1` (path speeds both reachable).
@@ -215,6 +236,10 @@ fn move_time(m: &Profile, v0: f64, v1: f64) -> f64 {
     let (mut lo, mut hi) = (v0.max(v1), m.top);
     for _ in 0..BISECTION_STEPS {
         let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            // Adjacent numbers: further steps leave `lo` as it is.
+            break;
+        }
         let d = change(v0, mid, m.accel, m.jerk).1 + change(mid, v1, m.accel, m.jerk).1;
         if d <= m.p {
             lo = mid;
@@ -363,5 +388,72 @@ pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> Pat
     PathTimes {
         seconds,
         from_joints,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`reach`] by bisection on [`change`]'s distance: the second method.
+    fn reach_by_bisection(from: f64, p: f64, cap: f64, accel: f64, jerk: f64) -> f64 {
+        if cap <= from || change(from, cap, accel, jerk).1 <= p {
+            return cap;
+        }
+        let (mut lo, mut hi) = (from, cap);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if change(from, mid, accel, jerk).1 <= p {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    }
+
+    #[test]
+    fn reach_equals_bisection_in_every_regime() {
+        // A fixed pseudo-random sequence (64-bit LCG), so the cases are the same every run.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut regimes = [0usize; 4];
+        for case in 0..20_000 {
+            // Speeds 0–100 mm/s, distances 1e-6–10 mm, accelerations 10–5000 mm/s², jerks
+            // 100–1e6 mm/s³ or none.
+            let from = if case % 5 == 0 { 0.0 } else { 100.0 * next() };
+            let cap = from + 100.0 * next();
+            let p = 10f64.powf(-6.0 + 7.0 * next());
+            let accel = 10f64.powf(1.0 + 2.7 * next());
+            let jerk = if case % 7 == 0 {
+                f64::INFINITY
+            } else {
+                10f64.powf(2.0 + 4.0 * next())
+            };
+            let want = reach_by_bisection(from, p, cap, accel, jerk);
+            let got = reach(from, p, cap, accel, jerk);
+            assert!(
+                (got - want).abs() <= 1e-9 * cap.max(1.0),
+                "from {from} p {p} cap {cap} a {accel} j {jerk}: {got} against {want}"
+            );
+            // Which closed form or search answered.
+            let k = if want >= cap {
+                0
+            } else if !jerk.is_finite() {
+                1
+            } else if want - from >= accel * accel / jerk {
+                2
+            } else {
+                3
+            };
+            regimes[k] += 1;
+        }
+        // Every regime was exercised.
+        assert!(regimes.iter().all(|&n| n > 100), "{regimes:?}");
     }
 }

@@ -15,7 +15,7 @@ use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
 use crate::error::Result;
 use crate::geom::Point3;
 use crate::model::Model;
-use crate::surface::diffgeom::DiffGeom;
+use crate::surface::diffgeom::unit_normal;
 use crate::verify::capsule::Capsule;
 use crate::verify::index::CapsuleIndex;
 use crate::verify::probe::{Material, Probe};
@@ -264,6 +264,10 @@ const EDGE_SAMPLES: usize = 17;
 const EDGE_REFINE_STEPS: usize = 24;
 /// Relative slack on whether two footprints' spheres meet (dimensionless).
 const TOUCH_SLACK: f64 = 0.05;
+/// A footprint's focus ball ([`Probe::focus`]) round its contact point, as a multiple of
+/// the distance to its farthest corner (dimensionless): room for a surface bulging between
+/// the corners; a sample outside it is measured through the index all the same.
+const FOCUS_GROWTH: f64 = 1.25;
 /// The pattern search's directions (steps in `u` and `v`).
 const PATTERN: [(f64, f64); 8] = [
     (1.0, 0.0),
@@ -319,31 +323,36 @@ pub fn tight_near_lifts(
     // the lifted contacts), then those whose footprint may touch a lifted point's.
     let cell = reach.max(1e-9);
     let key = |p: &Point3| [p.x, p.y, p.z].map(|x| (x / cell).floor() as i64);
+    // Each lifted contact is listed in its cell and the 26 around it, so a cut point needs
+    // one look-up (cut points outnumber lifted ones by hundreds).
     let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
     for (k, &i) in lifted.iter().enumerate() {
-        grid.entry(key(&path.moves[i].cc_point))
-            .or_default()
-            .push(k);
+        let c = key(&path.moves[i].cc_point);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    grid.entry([c[0] + dx, c[1] + dy, c[2] + dz])
+                        .or_default()
+                        .push(k);
+                }
+            }
+        }
     }
     let mut candidates = Vec::new();
+    let mut near: Vec<usize> = Vec::new();
     for (i, m) in path.moves.iter().enumerate() {
         if !m.kind.on_surface() || footprints[i].is_none() {
             continue;
         }
-        let c = key(&m.cc_point);
         // Lifted points whose contact is within reach, then whether the two footprints'
         // spheres (round the contact points, through the far corners) meet.
-        let mut near: Vec<usize> = Vec::new();
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(ks) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
-                        near.extend(ks.iter().copied().filter(|&k| {
-                            (path.moves[lifted[k]].cc_point - m.cc_point).norm() <= reach
-                        }));
-                    }
-                }
-            }
+        near.clear();
+        if let Some(ks) = grid.get(&key(&m.cc_point)) {
+            near.extend(
+                ks.iter()
+                    .copied()
+                    .filter(|&k| (path.moves[lifted[k]].cc_point - m.cc_point).norm() <= reach),
+            );
         }
         if near.is_empty() {
             continue;
@@ -354,12 +363,12 @@ pub fn tight_near_lifts(
                 <= (own + lifted_extent[k]) * (1.0 + TOUCH_SLACK)
         });
         if touches {
-            candidates.push(i);
+            candidates.push((i, own));
         }
     }
     // The swept balls near the candidates.
     let mut region = crate::geom::Aabb::empty();
-    for &i in &candidates {
+    for &(i, _) in &candidates {
         region.grow(&path.moves[i].cc_point);
     }
     let grow = reach + 2.0 * r;
@@ -389,8 +398,13 @@ pub fn tight_near_lifts(
         side: model.tool_side(),
         unreached_mm: f64::NEG_INFINITY,
     };
-    for i in candidates {
+    let near_mm = probe.probe.near_mm();
+    for (i, own) in candidates {
         let f = footprints[i];
+        // Every sample of the footprint tests only the balls near it.
+        probe
+            .probe
+            .focus(&path.moves[i].cc_point, FOCUS_GROWTH * own + near_mm);
         let [u0, u1, v0, v1] = f.rect;
         // A grid, then a pattern search from its highest sample: where a crease meets the
         // cusp between two passes the material left peaks sharply.
@@ -400,7 +414,6 @@ pub fn tight_near_lifts(
             .into_iter()
             .map(|(c, u, v)| (c.over, u, v))
             .collect();
-        let mut left_at = |u: f64, v: f64| probe.sample(&f, u, v).over;
         // The search starts from the grid's local maxima high enough to matter, highest first.
         let at_grid = |a: usize, b: usize| grid[a * TIGHT_SAMPLES + b].0;
         let mut starts: Vec<(f64, f64, f64)> = Vec::new();
@@ -417,9 +430,22 @@ pub fn tight_near_lifts(
         }
         starts.sort_by(|a, b| b.0.total_cmp(&a.0));
         let mut top = grid.iter().map(|g| g.0).fold(f64::NEG_INFINITY, f64::max);
+        let focus_at = |probe: &mut FootprintProbe, (u, v): (f64, f64), (hu, hv): (f64, f64)| {
+            let patch = &model.layout.patches[f.patch as usize];
+            let at = |u: f64, v: f64| patch.subs(&model.surface, u.clamp(u0, u1), v.clamp(v0, v1));
+            let c = at(u, v);
+            let far = [(-hu, -hv), (hu, -hv), (-hu, hv), (hu, hv)]
+                .iter()
+                .map(|&(a, b)| (at(u + a, v + b) - c).norm())
+                .fold(0.0, f64::max);
+            probe.probe.focus(&c, FOCUS_GROWTH * far + near_mm);
+        };
+        let searched = starts.len().min(TIGHT_SEARCH_STARTS) > 0;
         for &start in starts.iter().take(TIGHT_SEARCH_STARTS) {
             let mut best = start;
             let (mut su, mut sv) = (0.5 * du, 0.5 * dv);
+            // The search stays within (du, dv) of its start.
+            focus_at(&mut probe, (start.1, start.2), (du, dv));
             for _ in 0..TIGHT_SEARCH_HALVINGS {
                 if best.0 > scallop_mm {
                     break;
@@ -427,7 +453,7 @@ pub fn tight_near_lifts(
                 let (_, u, v) = best;
                 for (a, b) in PATTERN {
                     let (x, y) = ((u + a * su).clamp(u0, u1), (v + b * sv).clamp(v0, v1));
-                    let l = left_at(x, y);
+                    let l = probe.sample(&f, x, y).over;
                     if l > best.0 {
                         best = (l, x, y);
                     }
@@ -442,6 +468,12 @@ pub fn tight_near_lifts(
         // Along the footprint's sides on the patch boundary (where pass ends meet a crease,
         // the cusp between two lifted ends peaks within a sliver of the boundary line).
         if top <= scallop_mm {
+            if searched {
+                probe
+                    .probe
+                    .focus(&path.moves[i].cc_point, FOCUS_GROWTH * own + near_mm);
+            }
+            let mut left_at = |u: f64, v: f64| probe.sample(&f, u, v).over;
             let sides = [
                 (u0 <= 0.0, (u0, v0), (u0, v1)),
                 (u1 >= 1.0, (u1, v0), (u1, v1)),
@@ -513,12 +545,10 @@ impl FootprintProbe<'_> {
         let [u0, u1, v0, v1] = f.rect;
         let (u, v) = (u.clamp(u0, u1), v.clamp(v0, v1));
         let (model, p) = (self.model, &self.model.layout.patches[f.patch as usize]);
-        let d = p.derivs(&model.surface, u, v);
-        let area = d.su.cross(&d.sv).norm();
-        let nrm = DiffGeom::try_from_derivs(&d)
-            .map(|g| g.normal)
-            .or_else(|| p.normal(&model.surface, u, v));
-        let over = match nrm.map(|n| self.probe.measure(&d.point, &(n * self.side))) {
+        let (point, su, sv) = p.first_derivs(&model.surface, u, v);
+        let area = su.cross(&sv).norm();
+        let nrm = unit_normal(&su, &sv).or_else(|| p.normal(&model.surface, u, v));
+        let over = match nrm.map(|n| self.probe.measure(&point, &(n * self.side))) {
             None => f64::NEG_INFINITY,
             Some(Material::Left { left_mm, .. }) => left_mm,
             Some(Material::Unreached) => self.unreached_mm,

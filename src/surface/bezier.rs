@@ -128,6 +128,36 @@ impl BezierPatch {
         Point3::new(h.x / h.w, h.y / h.w, h.z / h.w)
     }
 
+    /// Point and first partial derivatives `(S, S_u, S_v)` at `(u, v)`: the same numbers,
+    /// bit for bit, as [`BezierPatch::derivs`] gives, without the second derivatives (for
+    /// points with normals, which need only these).
+    pub fn first_derivs(&self, u: f64, v: f64) -> (Point3, Vector3, Vector3) {
+        let (bu, dbu, _) = bernstein3(u);
+        let (bv, dbv, _) = bernstein3(v);
+        let mut r0 = [Vector4::zeros(); 4];
+        let mut r1 = [Vector4::zeros(); 4];
+        for j in 0..4 {
+            for i in 0..4 {
+                let c = self.cp[j][i];
+                r0[j] += c * bu[i];
+                r1[j] += c * dbu[i];
+            }
+        }
+        let mut a = Vector4::zeros();
+        let mut au = Vector4::zeros();
+        let mut av = Vector4::zeros();
+        for j in 0..4 {
+            a += r0[j] * bv[j];
+            av += r0[j] * dbv[j];
+            au += r1[j] * bv[j];
+        }
+        let inv = 1.0 / a.w;
+        let s = a.xyz() * inv;
+        let su = (au.xyz() - s * au.w) * inv;
+        let sv = (av.xyz() - s * av.w) * inv;
+        (Point3::from(s), su, sv)
+    }
+
     /// Point with first and second partial derivatives at `(u, v)`.
     pub fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
         let (bu, dbu, ddbu) = bernstein3(u);

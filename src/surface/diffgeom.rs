@@ -24,17 +24,23 @@ pub struct DiffGeom {
     pub n: f64,
 }
 
+/// The unit normal `(S_u × S_v) / |S_u × S_v|` from the first derivatives; `None` where
+/// the cross product vanishes against `|S_u| |S_v|` (see [`DiffGeom::try_from_derivs`]).
+pub fn unit_normal(su: &Vector3, sv: &Vector3) -> Option<Vector3> {
+    let cross = su.cross(sv);
+    let len = cross.norm();
+    let scale = su.norm() * sv.norm();
+    if !(len > 0.0) || !(len > scale * SINGULAR_SINE) {
+        return None;
+    }
+    Some(cross / len)
+}
+
 impl DiffGeom {
     /// Fundamental forms from derivatives; `None` where `S_u × S_v` vanishes (a degenerate or
     /// singular point, e.g. an extraordinary point), since no normal exists there.
     pub fn try_from_derivs(d: &SurfaceDerivs) -> Option<Self> {
-        let cross = d.su.cross(&d.sv);
-        let len = cross.norm();
-        let scale = d.su.norm() * d.sv.norm();
-        if !(len > 0.0) || !(len > scale * SINGULAR_SINE) {
-            return None;
-        }
-        let normal = cross / len;
+        let normal = unit_normal(&d.su, &d.sv)?;
         Some(DiffGeom {
             point: d.point,
             normal,

@@ -15,6 +15,7 @@ pub mod subdiv;
 pub mod tessellate;
 
 pub use bezier::{BezierPatch, SurfaceDerivs};
+use diffgeom::unit_normal;
 pub use diffgeom::DiffGeom;
 
 use crate::error::{Error, Result};
@@ -123,23 +124,48 @@ impl FaceSurface {
     /// Unit normal at `(u, v)`; where the tangent plane degenerates (an extraordinary
     /// point's limit), the normal of nearby points towards the face centre.
     pub fn normal(&self, u: f64, v: f64) -> Option<Vector3> {
-        if let Some(g) = DiffGeom::try_from_derivs(&self.derivs(u, v)) {
-            return Some(g.normal);
-        }
-        NORMAL_PROBES.iter().find_map(|&t| {
-            let (uu, vv) = (u + (0.5 - u) * t, v + (0.5 - v) * t);
-            DiffGeom::try_from_derivs(&self.derivs(uu, vv)).map(|g| g.normal)
+        let unit_at = |u, v| {
+            let (_, su, sv) = self.first_derivs(u, v);
+            unit_normal(&su, &sv)
+        };
+        unit_at(u, v).or_else(|| {
+            NORMAL_PROBES.iter().find_map(|&t| {
+                let (uu, vv) = (u + (0.5 - u) * t, v + (0.5 - v) * t);
+                unit_at(uu, vv)
+            })
         })
     }
 
     /// Point and unit normal at `(u, v)` from one evaluation (the normal as
     /// [`FaceSurface::normal`] gives it).
     pub fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
-        let d = self.derivs(u, v);
-        let n = DiffGeom::try_from_derivs(&d)
-            .map(|g| g.normal)
-            .or_else(|| self.normal(u, v));
-        (d.point, n)
+        let (p, su, sv) = self.first_derivs(u, v);
+        let n = unit_normal(&su, &sv).or_else(|| self.normal(u, v));
+        (p, n)
+    }
+
+    /// Point and first derivatives `(S, S_u, S_v)` at `(u, v)`, equal to those of
+    /// [`FaceSurface::derivs`] without computing the second derivatives of a grid face.
+    pub fn first_derivs(&self, u: f64, v: f64) -> (Point3, Vector3, Vector3) {
+        match &self.form {
+            FaceForm::Grid {
+                u_breaks,
+                v_breaks,
+                cells,
+            } => {
+                let (i, j) = (
+                    cell_of(u_breaks, u).min(u_breaks.len() - 2),
+                    cell_of(v_breaks, v).min(v_breaks.len() - 2),
+                );
+                let ((tu, su), (tv, sv)) = (local(u_breaks, i, u), local(v_breaks, j, v));
+                let (p, du, dv) = cells[j * (u_breaks.len() - 1) + i].first_derivs(tu, tv);
+                (p, du * su, dv * sv)
+            }
+            FaceForm::Tree(node) => {
+                let d = node.derivs(u, v);
+                (d.point, d.su, d.sv)
+            }
+        }
     }
 
     /// Number of Bézier cells.

@@ -155,7 +155,10 @@ impl Capsule {
                 None => (t_in, pin),
             }
         };
-        Span::within(t_in, t_out.max(t_in), pin, pout, lo, hi)
+        // A plain comparison: `f64::max` is a call in wasm (for its NaN rule), and this runs
+        // for every capsule a probe passes.
+        let t_out = if t_out < t_in { t_in } else { t_out };
+        Span::within(t_in, t_out, pin, pout, lo, hi)
     }
 
     /// Outward unit normal of the capsule where the line of `span` enters it.

@@ -215,6 +215,44 @@ impl CapsuleIndex {
         }
     }
 
+    /// Whether the box `lo..hi` lies inside the indexed region.
+    pub fn holds_box(&self, lo: &Point3, hi: &Point3) -> bool {
+        (0..3).all(|k| {
+            lo[k] >= self.origin[k] && hi[k] <= self.origin[k] + self.dims[k] as f64 * self.cell_mm
+        })
+    }
+
+    /// Calls `f` once with every capsule listed in a cell the box `lo..hi` overlaps (clipped
+    /// to the grid): among them, every capsule that comes within the radius of a point of
+    /// the box. `seen` and `stamp` as for [`CapsuleIndex::visit`].
+    pub fn visit_box(
+        &self,
+        lo: &Point3,
+        hi: &Point3,
+        seen: &mut [u32],
+        stamp: u32,
+        mut f: impl FnMut(u32),
+    ) {
+        let Some(range) = self.cell_range(&[lo.x, lo.y, lo.z], &[hi.x, hi.y, hi.z]) else {
+            return;
+        };
+        for z in range[2].0..=range[2].1 {
+            for y in range[1].0..=range[1].1 {
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                for x in range[0].0..=range[0].1 {
+                    let cell = row + x;
+                    let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
+                    for &i in &self.items[s..e] {
+                        if seen[i as usize] != stamp {
+                            seen[i as usize] = stamp;
+                            f(i);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// Edge length of a cell (mm).
     pub fn cell_mm(&self) -> f64 {
         self.cell_mm

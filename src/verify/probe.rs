@@ -8,6 +8,8 @@ use crate::geom::{Point3, Vector3};
 
 /// Length of the first look along the normal, either way, in index cells.
 const NEAR_CELLS: f64 = 0.1;
+/// Relative slack on a focus's distance test, for rounding (dimensionless).
+const FOCUS_SLACK: f64 = 1e-9;
 
 /// The capsule that decides a measurement and where the line meets it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,6 +44,15 @@ pub struct Probe<'a> {
     hits: Vec<(u32, Span)>,
     /// Straight depth of the point last measured, where it was swept.
     depth: Option<f64>,
+    /// The capsules near a small ball that queries inside it test ([`Probe::focus`]).
+    focus: Option<Focus>,
+}
+
+/// The capsules that may meet a segment within `radius` of `centre`, in index order.
+struct Focus {
+    centre: Point3,
+    radius: f64,
+    capsules: Vec<u32>,
 }
 
 impl<'a> Probe<'a> {
@@ -62,19 +73,78 @@ impl<'a> Probe<'a> {
             stamp: 0,
             hits: Vec::new(),
             depth: None,
+            focus: None,
+        }
+    }
+
+    /// Length of the first look along the normal, either way (mm).
+    pub fn near_mm(&self) -> f64 {
+        (NEAR_CELLS * self.index.cell_mm()).min(self.reach)
+    }
+
+    /// Lists once the capsules that may meet a query segment lying within `radius` of
+    /// `centre` (those whose segment comes within the tool radius plus `radius` of it);
+    /// queries inside that ball then test only these, others go through the index as
+    /// before. The capsules found are the same either way (every capsule a segment meets
+    /// is in both), though maybe in another order. Many measurements round one small
+    /// spot then cost a few capsule tests each instead of a grid cell's worth.
+    pub fn focus(&mut self, centre: &Point3, radius: f64) {
+        let g = Vector3::repeat(radius);
+        let (lo, hi) = (centre - g, centre + g);
+        let mut list = self.focus.take().map(|f| f.capsules).unwrap_or_default();
+        list.clear();
+        // Only inside the grid: outside it the index lists nothing, and the focus must find
+        // what the index finds.
+        if !self.index.holds_box(&lo, &hi) {
+            return;
+        }
+        self.next_stamp();
+        let within = (self.radius + radius) * (1.0 + FOCUS_SLACK);
+        let caps = self.capsules;
+        self.index
+            .visit_box(&lo, &hi, &mut self.seen, self.stamp, |i| {
+                if (caps[i as usize].closest_on_axis(centre) - centre).norm() <= within {
+                    list.push(i);
+                }
+            });
+        list.sort_unstable();
+        self.focus = Some(Focus {
+            centre: *centre,
+            radius,
+            capsules: list,
+        });
+    }
+
+    /// Queries go through the index again.
+    pub fn unfocus(&mut self) {
+        self.focus = None;
+    }
+
+    fn next_stamp(&mut self) {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.seen.iter_mut().for_each(|s| *s = 0);
+            self.stamp = 1;
         }
     }
 
     /// Hits of the line `p + t·n` for `t` in `[lo, hi]` with every capsule near it.
     fn gather(&mut self, p: &Point3, n: &Vector3, lo: f64, hi: f64) {
         self.hits.clear();
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.seen.iter_mut().for_each(|s| *s = 0);
-            self.stamp = 1;
-        }
         let (a, b) = (p + n * lo, p + n * hi);
-        let (caps, r, hits) = (self.capsules, self.radius, &mut self.hits);
+        let (caps, r) = (self.capsules, self.radius);
+        if let Some(f) = &self.focus {
+            if (a - f.centre).norm() <= f.radius && (b - f.centre).norm() <= f.radius {
+                for &i in &f.capsules {
+                    if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
+                        self.hits.push((i, h));
+                    }
+                }
+                return;
+            }
+        }
+        self.next_stamp();
+        let hits = &mut self.hits;
         self.index.visit(&a, &b, &mut self.seen, self.stamp, |i| {
             if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
                 hits.push((i, h));
@@ -85,11 +155,7 @@ impl<'a> Probe<'a> {
     /// The capsule nearest to `p` (distance from its segment) within `within` mm, and the
     /// closest point of its segment; used to tell which side of the surface the tool is on.
     pub fn nearest_centre(&mut self, p: &Point3, n: &Vector3, within: f64) -> Option<Point3> {
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.seen.iter_mut().for_each(|s| *s = 0);
-            self.stamp = 1;
-        }
+        self.next_stamp();
         let (a, b) = (p - n * within, p + n * within);
         let caps = self.capsules;
         let mut best: Option<(f64, Point3)> = None;
@@ -136,7 +202,7 @@ impl<'a> Probe<'a> {
         // Most points are cut within a cell's length above them or lie in the thin layer a
         // chord cuts below the surface: one look over [−near, near] serves both. Every
         // capsule containing `p` or entered before `near` meets that segment.
-        let near = (NEAR_CELLS * self.index.cell_mm()).min(self.reach);
+        let near = self.near_mm();
         self.gather(p, n, -near, near);
         self.depth = None;
         let contains = |h: &Span| h.t_in <= 0.0 && h.t_out >= 0.0;

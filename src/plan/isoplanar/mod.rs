@@ -814,10 +814,14 @@ fn too_wide(
     (out, worst_ok)
 }
 
+/// A [`SegmentIndex`] cell's edge in reaches: a piece's middle lies within a quarter reach
+/// (half its length) of every point of it.
+const SEGMENT_CELL_REACHES: f64 = 1.25;
+
 /// Nearest-segment queries among segments within a reach, through a uniform grid of cells
-/// twice the reach: each segment is listed in the cells of the middles of its pieces no
-/// longer than half the reach, so that any of its points within the reach of a query lies
-/// in the query's cell or a neighbour.
+/// 1¼ times the reach: each segment is listed in the cells of the middles of its pieces no
+/// longer than half the reach, so that the piece holding any of its points within the reach
+/// of a query has its middle within 1¼ reaches, in the query's cell or a neighbour.
 struct SegmentIndex<'a> {
     segments: &'a [(Point3, Point3)],
     cell: f64,
@@ -828,7 +832,7 @@ struct SegmentIndex<'a> {
 impl<'a> SegmentIndex<'a> {
     fn new(segments: &'a [(Point3, Point3)], reach: f64) -> Self {
         let reach = reach.max(1e-9);
-        let cell = 2.0 * reach;
+        let cell = SEGMENT_CELL_REACHES * reach;
         let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
         for (i, (a, b)) in segments.iter().enumerate() {
             let pieces = ((b - a).norm() / (0.5 * reach)).ceil().max(1.0) as usize;
