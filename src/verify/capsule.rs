@@ -31,6 +31,7 @@ pub struct LineHit {
 const PARALLEL_SIN2: f64 = 1e-14;
 
 /// Interval of the line `o + t·n` inside the ball of radius `r` centred at `c`.
+#[inline(always)]
 fn sphere(c: &Point3, r: f64, o: &Point3, n: &Vector3) -> Option<(f64, f64)> {
     let w = o - c;
     let b = w.dot(n);
@@ -75,7 +76,7 @@ impl Capsule {
 
     /// The part of the line `o + t·n` (`n` a unit vector) inside the capsule of radius `r`,
     /// if it overlaps `[lo, hi]`; the cheap form of [`Capsule::intersect_line`] (no normal).
-    #[inline]
+    #[inline(always)]
     pub fn interval(&self, r: f64, o: &Point3, n: &Vector3, lo: f64, hi: f64) -> Option<Span> {
         let w = o - self.start;
         let wn = w.dot(n);

@@ -33,7 +33,7 @@ use super::pipeline::Planned;
 use super::stepover;
 use super::PlanOptions;
 use crate::error::{Error, Result};
-use crate::geom::{dist_to_segment, nearest_on_segment, Point3, Vector3};
+use crate::geom::{dist_to_segment, nearest_on_segment, Aabb, Point3, Vector3};
 use crate::model::Model;
 use crate::surface::{DiffGeom, SurfaceDerivs};
 use serde::{Deserialize, Serialize};
@@ -61,6 +61,8 @@ const LINK_SPACINGS: f64 = 3.0;
 /// Cosine of the angle from square to the feed within which a neighbouring pass counts as
 /// beside a point (60°).
 const BESIDE_COS: f64 = 0.5;
+/// Relative widening of a [`SegmentIndex`] query's window along its axis, for rounding.
+const SEGMENT_WINDOW_SLACK: f64 = 1e-9;
 /// Most times the planes between two neighbours are halved where the predicted cusp is
 /// over the scallop.
 pub const MAX_SPLITS: usize = 3;
@@ -371,7 +373,7 @@ pub fn slices(
             let tris = tris_at(c);
             let mut kept: Vec<Pass> = Vec::new();
             for p in cut(c, &tris) {
-                kept.extend(keep_near(p, &near, LINK_SPACINGS * spacing));
+                kept.extend(keep_near(p, &near, &frame.y, LINK_SPACINGS * spacing));
             }
             if !kept.is_empty() {
                 added_planes += 1;
@@ -790,7 +792,7 @@ fn too_wide(
         }
         let (mut near, mut worst) = (Vec::new(), 0.0f64);
         for (from, to) in [(a, b), (b, a)] {
-            let index = SegmentIndex::new(&to.segments, reach);
+            let index = SegmentIndex::new(&to.segments, &frame.y, reach);
             for &(p, cl, kappa, t) in &from.points {
                 // The neighbouring pass beside the point, not beyond its end (where the
                 // surface ends before the next plane, nothing lies between them).
@@ -814,46 +816,48 @@ fn too_wide(
     (out, worst_ok)
 }
 
-/// A [`SegmentIndex`] cell's edge in reaches: a piece's middle lies within a quarter reach
-/// (half its length) of every point of it.
-const SEGMENT_CELL_REACHES: f64 = 1.25;
-
-/// Nearest-segment queries among segments within a reach, through a uniform grid of cells
-/// 1¼ times the reach: each segment is listed in the cells of the middles of its pieces no
-/// longer than half the reach, so that the piece holding any of its points within the reach
-/// of a query has its middle within 1¼ reaches, in the query's cell or a neighbour.
+/// Nearest-segment queries among segments within a reach: the segments sorted by where they
+/// begin along an axis (the planes' horizontal direction, along which passes run), so that
+/// a query tests only those whose extent along it comes within the reach of its own.
 struct SegmentIndex<'a> {
     segments: &'a [(Point3, Point3)],
-    cell: f64,
+    axis: Vector3,
     reach: f64,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    /// Each segment's lowest coordinate along the axis, its index and its box, in order.
+    order: Vec<(f64, u32, Aabb)>,
+    /// The largest extent of a segment along the axis (mm).
+    longest: f64,
 }
 
 impl<'a> SegmentIndex<'a> {
-    fn new(segments: &'a [(Point3, Point3)], reach: f64) -> Self {
-        let reach = reach.max(1e-9);
-        let cell = SEGMENT_CELL_REACHES * reach;
-        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    /// The index of `segments` along the unit vector `axis`. A segment is listed as pieces
+    /// no longer than half the reach, so that one long segment does not widen every query's
+    /// window; a query tests the whole segment of every piece that passes.
+    fn new(segments: &'a [(Point3, Point3)], axis: &Vector3, reach: f64) -> Self {
+        let mut longest: f64 = 0.0;
+        let mut order: Vec<(f64, u32, Aabb)> = Vec::with_capacity(segments.len());
         for (i, (a, b)) in segments.iter().enumerate() {
             let pieces = ((b - a).norm() / (0.5 * reach)).ceil().max(1.0) as usize;
-            let mut last = None;
             for k in 0..pieces {
-                let m = a + (b - a) * ((k as f64 + 0.5) / pieces as f64);
-                let key = [m.x, m.y, m.z].map(|x| (x / cell).floor() as i64);
-                if last != Some(key) {
-                    let list = cells.entry(key).or_default();
-                    if list.last() != Some(&(i as u32)) {
-                        list.push(i as u32);
-                    }
-                    last = Some(key);
-                }
+                let (p, q) = (
+                    a + (b - a) * (k as f64 / pieces as f64),
+                    a + (b - a) * ((k + 1) as f64 / pieces as f64),
+                );
+                let (x, y) = (p.coords.dot(axis), q.coords.dot(axis));
+                longest = longest.max((x - y).abs());
+                let mut bounds = Aabb::empty();
+                bounds.grow(&p);
+                bounds.grow(&q);
+                order.push((x.min(y), i as u32, bounds));
             }
         }
+        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         SegmentIndex {
             segments,
-            cell,
+            axis: *axis,
             reach,
-            cells,
+            order,
+            longest,
         }
     }
 
@@ -871,24 +875,31 @@ impl<'a> SegmentIndex<'a> {
     /// Distance (mm) to the nearest point of a segment within the reach whose offset from
     /// `q` passes `keep`.
     fn nearest_where(&self, q: &Point3, keep: &dyn Fn(&Vector3) -> bool) -> Option<f64> {
-        let c = [q.x, q.y, q.z].map(|x| (x / self.cell).floor() as i64);
+        // A point within the reach lies within it along the axis too; its segment begins at
+        // most the longest extent before it (the slack covers rounding).
+        let y = q.coords.dot(&self.axis);
+        let slack = SEGMENT_WINDOW_SLACK * (self.reach + y.abs() + self.longest);
+        let (lo, hi) = (
+            y - self.reach - self.longest - slack,
+            y + self.reach + slack,
+        );
+        let first = self.order.partition_point(|e| e.0 < lo);
         let mut best: Option<f64> = None;
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let Some(v) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
-                        continue;
-                    };
-                    // (A segment listed in several neighbouring cells is measured again.)
-                    for &i in v {
-                        let (a, b) = self.segments[i as usize];
-                        let v = nearest_on_segment(q, &a, &b) - q;
-                        let d = v.norm();
-                        if d <= self.reach && keep(&v) && best.is_none_or(|x| d < x) {
-                            best = Some(d);
-                        }
-                    }
-                }
+        // Where walls run across the axis many segments share a window: their boxes, grown
+        // by the reach, turn most away cheaply.
+        let r = self.reach + slack;
+        for (start, i, bounds) in &self.order[first..] {
+            if *start > hi {
+                break;
+            }
+            if (0..3).any(|k| q[k] < bounds.min[k] - r || q[k] > bounds.max[k] + r) {
+                continue;
+            }
+            let (a, b) = self.segments[*i as usize];
+            let v = nearest_on_segment(q, &a, &b) - q;
+            let d = v.norm();
+            if d <= self.reach && keep(&v) && best.is_none_or(|x| d < x) {
+                best = Some(d);
             }
         }
         best
@@ -897,9 +908,9 @@ impl<'a> SegmentIndex<'a> {
 
 /// The parts of `pass` whose CL points lie within `reach` (mm) of a point of `near`, as
 /// separate open passes.
-fn keep_near(pass: Pass, near: &[Point3], reach: f64) -> Vec<Pass> {
+fn keep_near(pass: Pass, near: &[Point3], axis: &Vector3, reach: f64) -> Vec<Pass> {
     let segments: Vec<(Point3, Point3)> = near.iter().map(|&p| (p, p)).collect();
-    let index = SegmentIndex::new(&segments, reach);
+    let index = SegmentIndex::new(&segments, axis, reach);
     let mut out = Vec::new();
     let mut run: Vec<SlicePoint> = Vec::new();
     for s in &pass.points {
