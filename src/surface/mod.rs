@@ -57,6 +57,23 @@ fn cell_of(breaks: &[f64], x: f64) -> usize {
     breaks[1..n].partition_point(|&b| b <= x).min(n - 1)
 }
 
+/// Bézier cell `cell` of a grid face (clamped to the grid), as its index in the face's
+/// cells, `(u, v)`'s parameters inside it and the scales from them to the face's.
+fn grid_cell(
+    u_breaks: &[f64],
+    v_breaks: &[f64],
+    cell: [usize; 2],
+    u: f64,
+    v: f64,
+) -> (usize, [f64; 2], [f64; 2]) {
+    let (i, j) = (
+        cell[0].min(u_breaks.len() - 2),
+        cell[1].min(v_breaks.len() - 2),
+    );
+    let ((tu, su), (tv, sv)) = (local(u_breaks, i, u), local(v_breaks, j, v));
+    (j * (u_breaks.len() - 1) + i, [tu, tv], [su, sv])
+}
+
 /// `x` in cell `i` of `breaks`: its local parameter and the cell's scale `1 / span`.
 fn local(breaks: &[f64], i: usize, x: f64) -> (f64, f64) {
     let span = breaks[i + 1] - breaks[i];
@@ -92,14 +109,8 @@ impl FaceSurface {
                 v_breaks,
                 cells,
             } => {
-                let (i, j) = (
-                    cell[0].min(u_breaks.len() - 2),
-                    cell[1].min(v_breaks.len() - 2),
-                );
-                let ((tu, su), (tv, sv)) = (local(u_breaks, i, u), local(v_breaks, j, v));
-                cells[j * (u_breaks.len() - 1) + i]
-                    .derivs(tu, tv)
-                    .scaled(su, sv)
+                let (k, [tu, tv], [su, sv]) = grid_cell(u_breaks, v_breaks, cell, u, v);
+                cells[k].derivs(tu, tv).scaled(su, sv)
             }
             FaceForm::Tree(node) => node.derivs(u, v),
         }
@@ -153,12 +164,9 @@ impl FaceSurface {
                 v_breaks,
                 cells,
             } => {
-                let (i, j) = (
-                    cell_of(u_breaks, u).min(u_breaks.len() - 2),
-                    cell_of(v_breaks, v).min(v_breaks.len() - 2),
-                );
-                let ((tu, su), (tv, sv)) = (local(u_breaks, i, u), local(v_breaks, j, v));
-                let (p, du, dv) = cells[j * (u_breaks.len() - 1) + i].first_derivs(tu, tv);
+                let cell = [cell_of(u_breaks, u), cell_of(v_breaks, v)];
+                let (k, [tu, tv], [su, sv]) = grid_cell(u_breaks, v_breaks, cell, u, v);
+                let (p, du, dv) = cells[k].first_derivs(tu, tv);
                 (p, du * su, dv * sv)
             }
             FaceForm::Tree(node) => {
