@@ -834,6 +834,7 @@ impl<'a> SegmentIndex<'a> {
     /// no longer than half the reach, so that one long segment does not widen every query's
     /// window; a query tests the whole segment of every piece that passes.
     fn new(segments: &'a [(Point3, Point3)], axis: &Vector3, reach: f64) -> Self {
+        let reach = reach.max(1e-9);
         let mut longest: f64 = 0.0;
         let mut order: Vec<(f64, u32, Aabb)> = Vec::with_capacity(segments.len());
         for (i, (a, b)) in segments.iter().enumerate() {
