@@ -424,3 +424,58 @@ fn samples_have_their_documented_counts_and_sizes() {
         }
     }
 }
+
+/// Points with first derivatives only (`FaceSurface::first_derivs`, `point_normal`, the
+/// layout's `Patch::first_derivs`) are the numbers the full evaluation gives, bit for bit,
+/// on grid faces (T-splines) and subdivision trees (Catmull–Clark cages, extraordinary
+/// points) alike.
+#[test]
+fn first_derivatives_alone_equal_the_full_evaluation_bit_for_bit() {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut trees = 0;
+    for s in SAMPLES {
+        let m = samples::load_sample(s.name).unwrap();
+        for f in m.surface.faces() {
+            trees += matches!(f.form, tspath::surface::FaceForm::Tree(_)) as usize;
+            // Corners, sides and random points.
+            let uvs = [(0.0, 0.0), (1.0, 1.0), (0.5, 1.0)]
+                .into_iter()
+                .chain((0..40).map(|_| (next(), next())));
+            for (u, v) in uvs {
+                let d = f.derivs(u, v);
+                let (p, su, sv) = f.first_derivs(u, v);
+                assert_eq!(
+                    (p, su, sv),
+                    (d.point, d.su, d.sv),
+                    "{} at ({u}, {v})",
+                    s.name
+                );
+                let (q, n) = f.point_normal(u, v);
+                assert_eq!(q, d.point);
+                let want = DiffGeom::try_from_derivs(&d)
+                    .map(|g| g.normal)
+                    .or_else(|| f.normal(u, v));
+                assert_eq!(n, want, "{} at ({u}, {v})", s.name);
+            }
+        }
+        for p in &m.layout.patches {
+            for _ in 0..40 {
+                let (u, v) = (next(), next());
+                let d = p.derivs(&m.surface, u, v);
+                assert_eq!(
+                    p.first_derivs(&m.surface, u, v),
+                    (d.point, d.su, d.sv),
+                    "{}",
+                    s.name
+                );
+            }
+        }
+    }
+    assert!(trees > 0, "no subdivision face among the samples");
+}

@@ -156,7 +156,7 @@ impl FaceSurface {
     }
 
     /// Point and first derivatives `(S, S_u, S_v)` at `(u, v)`, equal to those of
-    /// [`FaceSurface::derivs`] without computing the second derivatives of a grid face.
+    /// [`FaceSurface::derivs`] without computing the second derivatives.
     pub fn first_derivs(&self, u: f64, v: f64) -> (Point3, Vector3, Vector3) {
         match &self.form {
             FaceForm::Grid {
@@ -169,10 +169,7 @@ impl FaceSurface {
                 let (p, du, dv) = cells[k].first_derivs(tu, tv);
                 (p, du * su, dv * sv)
             }
-            FaceForm::Tree(node) => {
-                let d = node.derivs(u, v);
-                (d.point, d.su, d.sv)
-            }
+            FaceForm::Tree(node) => node.first_derivs(u, v),
         }
     }
 

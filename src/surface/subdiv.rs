@@ -53,28 +53,34 @@ pub enum Node {
     Cap(Vector4),
 }
 
+/// Where a point of a [`Node`] lies: in a leaf's Bézier cell (at `uv` there, the cell `scale`
+/// times smaller than the node), or on a cap.
+enum Found<'a> {
+    Leaf {
+        patch: &'a BezierPatch,
+        origin: &'a Vector3,
+        uv: [f64; 2],
+        scale: f64,
+    },
+    Cap(Point3),
+}
+
 impl Node {
-    /// Point and derivatives at `(u, v)` in the node's square `[0,1]²`.
-    pub fn derivs(&self, mut u: f64, mut v: f64) -> SurfaceDerivs {
+    /// The leaf or cap holding `(u, v)` (in the node's square `[0,1]²`).
+    fn descend(&self, mut u: f64, mut v: f64) -> Found<'_> {
         let mut node = self;
         let mut scale = 1.0;
         loop {
             match node {
                 Node::Leaf { patch, origin } => {
-                    let mut d = patch.derivs(u, v).scaled(scale, scale);
-                    d.point += origin;
-                    return d;
-                }
-                Node::Cap(h) => {
-                    return SurfaceDerivs {
-                        point: Point3::new(h.x / h.w, h.y / h.w, h.z / h.w),
-                        su: Vector3::zeros(),
-                        sv: Vector3::zeros(),
-                        suu: Vector3::zeros(),
-                        suv: Vector3::zeros(),
-                        svv: Vector3::zeros(),
+                    return Found::Leaf {
+                        patch,
+                        origin,
+                        uv: [u, v],
+                        scale,
                     }
                 }
+                Node::Cap(h) => return Found::Cap(Point3::new(h.x / h.w, h.y / h.w, h.z / h.w)),
                 Node::Split(ch) => {
                     let (hu, hv) = (u >= 0.5, v >= 0.5);
                     u = if hu { 2.0 * u - 1.0 } else { 2.0 * u };
@@ -83,6 +89,47 @@ impl Node {
                     node = &ch[(hu as usize) + 2 * (hv as usize)];
                 }
             }
+        }
+    }
+
+    /// Point and derivatives at `(u, v)` in the node's square `[0,1]²`.
+    pub fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
+        match self.descend(u, v) {
+            Found::Leaf {
+                patch,
+                origin,
+                uv,
+                scale,
+            } => {
+                let mut d = patch.derivs(uv[0], uv[1]).scaled(scale, scale);
+                d.point += origin;
+                d
+            }
+            Found::Cap(point) => SurfaceDerivs {
+                point,
+                su: Vector3::zeros(),
+                sv: Vector3::zeros(),
+                suu: Vector3::zeros(),
+                suv: Vector3::zeros(),
+                svv: Vector3::zeros(),
+            },
+        }
+    }
+
+    /// Point and first derivatives at `(u, v)` in the node's square `[0,1]²`: those of
+    /// [`Node::derivs`] without the second derivatives.
+    pub fn first_derivs(&self, u: f64, v: f64) -> (Point3, Vector3, Vector3) {
+        match self.descend(u, v) {
+            Found::Leaf {
+                patch,
+                origin,
+                uv,
+                scale,
+            } => {
+                let (p, su, sv) = patch.first_derivs(uv[0], uv[1]);
+                (p + origin, su * scale, sv * scale)
+            }
+            Found::Cap(point) => (point, Vector3::zeros(), Vector3::zeros()),
         }
     }
 

@@ -864,18 +864,18 @@ impl<'a> SegmentIndex<'a> {
 
     /// Distance (mm) to the nearest segment, if one lies within the reach.
     fn nearest(&self, q: &Point3) -> Option<f64> {
-        self.nearest_where(q, &|_| true)
+        self.nearest_where(q, |_, _| true)
     }
 
     /// Distance (mm) to the nearest point of a segment within the reach that lies beside
     /// `q` as seen along the unit direction `t` (within 60° of square to it).
     fn nearest_beside(&self, q: &Point3, t: &Vector3) -> Option<f64> {
-        self.nearest_where(q, &|v: &Vector3| v.dot(t).abs() <= BESIDE_COS * v.norm())
+        self.nearest_where(q, |v: &Vector3, d: f64| v.dot(t).abs() <= BESIDE_COS * d)
     }
 
     /// Distance (mm) to the nearest point of a segment within the reach whose offset from
-    /// `q` passes `keep`.
-    fn nearest_where(&self, q: &Point3, keep: &dyn Fn(&Vector3) -> bool) -> Option<f64> {
+    /// `q` passes `keep` (given the offset and its length).
+    fn nearest_where(&self, q: &Point3, keep: impl Fn(&Vector3, f64) -> bool) -> Option<f64> {
         // A point within the reach lies within it along the axis too; its segment begins at
         // most the longest extent before it (the slack covers rounding).
         let y = q.coords.dot(&self.axis);
@@ -899,7 +899,8 @@ impl<'a> SegmentIndex<'a> {
             let (a, b) = self.segments[*i as usize];
             let v = nearest_on_segment(q, &a, &b) - q;
             let d = v.norm();
-            if d <= self.reach && keep(&v) && best.is_none_or(|x| d < x) {
+            // `keep` last: it is asked only of a point that would be the nearest so far.
+            if d <= self.reach && best.is_none_or(|x| d < x) && keep(&v, d) {
                 best = Some(d);
             }
         }
