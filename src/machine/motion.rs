@@ -414,14 +414,8 @@ mod tests {
 
     #[test]
     fn reach_equals_bisection_in_every_regime() {
-        // A fixed pseudo-random sequence (64-bit LCG), so the cases are the same every run.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        // A fixed pseudo-random sequence, so the cases are the same every run.
+        let mut next = crate::testing::uniform(0x2545_f491_4f6c_dd1d);
         let mut regimes = [0usize; 4];
         for case in 0..20_000 {
             // Speeds 0–100 mm/s, distances 1e-6–10 mm, accelerations 10–5000 mm/s², jerks
