@@ -135,15 +135,7 @@ impl CapsuleIndex {
         stamp: u32,
         mut f: impl FnMut(u32),
     ) {
-        let mut emit = |cell: usize| {
-            let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
-            for &i in &self.items[s..e] {
-                if seen[i as usize] != stamp {
-                    seen[i as usize] = stamp;
-                    f(i);
-                }
-            }
-        };
+        let mut emit = |cell: usize| self.emit_new(cell, seen, stamp, &mut f);
         // Clip the segment to the grid's box (slabs).
         let d = b - a;
         let (mut t0, mut t1) = (0.0f64, 1.0f64);
@@ -233,22 +225,20 @@ impl CapsuleIndex {
         stamp: u32,
         mut f: impl FnMut(u32),
     ) {
-        let Some(range) = self.cell_range(&[lo.x, lo.y, lo.z], &[hi.x, hi.y, hi.z]) else {
-            return;
-        };
-        for z in range[2].0..=range[2].1 {
-            for y in range[1].0..=range[1].1 {
-                let row = (z * self.dims[1] + y) * self.dims[0];
-                for x in range[0].0..=range[0].1 {
-                    let cell = row + x;
-                    let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
-                    for &i in &self.items[s..e] {
-                        if seen[i as usize] != stamp {
-                            seen[i as usize] = stamp;
-                            f(i);
-                        }
-                    }
-                }
+        if let Some(range) = self.cell_range(&[lo.x, lo.y, lo.z], &[hi.x, hi.y, hi.z]) {
+            self.for_cells(&range, |cell| self.emit_new(cell, seen, stamp, &mut f));
+        }
+    }
+
+    /// Calls `f` with every capsule listed in `cell` not yet marked `stamp` in `seen`, and
+    /// marks it.
+    #[inline]
+    fn emit_new(&self, cell: usize, seen: &mut [u32], stamp: u32, f: &mut impl FnMut(u32)) {
+        let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
+        for &i in &self.items[s..e] {
+            if seen[i as usize] != stamp {
+                seen[i as usize] = stamp;
+                f(i);
             }
         }
     }
