@@ -1,7 +1,9 @@
 //! Catmull–Clark evaluation against plain subdivision written independently here: every
 //! face of the cage is subdivided a few times with the textbook rules (sharp boundaries,
-//! corners kept), the limit positions of the fine vertices are taken with the textbook limit
-//! masks, and compared with the library's evaluation at the same dyadic parameters.
+//! corners kept; creases of integer sharpness `s` sharp for `s` steps, infinitely sharp ones
+//! always, after DeRose, Kass & Truong 1998), the limit positions of the fine vertices are
+//! taken with the textbook limit masks, and compared with the library's evaluation at the
+//! same dyadic parameters.
 
 use std::collections::HashMap;
 use tspath::model::samples;
@@ -27,6 +29,36 @@ struct Mesh {
     /// (cage face, u0, v0, size): corner 0 of the quad sits at (u0, v0) of the cage face,
     /// corner 1 at (u0 + size, v0), corner 3 at (u0, v0 + size).
     origin: Vec<(usize, f64, f64, f64)>,
+    /// Sharpness of creased edges `(min, max)` (infinite: always sharp), and of corners.
+    sharp: HashMap<(usize, usize), f64>,
+    corner: HashMap<usize, f64>,
+    /// Boundary vertices with one face stay put (edge-and-corner interpolation).
+    corners_interpolated: bool,
+}
+
+impl Mesh {
+    /// Sharpness of edge `e` (boundary edges infinitely sharp).
+    fn edge_sharpness(&self, ef: &HashMap<(usize, usize), Vec<usize>>, e: (usize, usize)) -> f64 {
+        if ef[&e].len() == 1 {
+            f64::INFINITY
+        } else {
+            self.sharp.get(&e).copied().unwrap_or(0.0)
+        }
+    }
+
+    /// Sharpness of vertex `v`: tagged, or infinite at a boundary vertex with one face.
+    fn vertex_sharpness(&self, v: usize, faces: usize, boundary: bool) -> f64 {
+        if boundary && faces == 1 && self.corners_interpolated {
+            f64::INFINITY
+        } else {
+            self.corner.get(&v).copied().unwrap_or(0.0)
+        }
+    }
+}
+
+/// One less, for the next step.
+fn decay(s: f64) -> f64 {
+    s - 1.0
 }
 
 fn edge_faces(m: &Mesh) -> HashMap<(usize, usize), Vec<usize>> {
@@ -62,20 +94,20 @@ fn subdivide(m: &Mesh) -> Mesh {
     let mut pts = Vec::new();
     for v in 0..n {
         let p = m.pts[v];
-        let bnd: Vec<usize> = vedges[v]
+        let boundary = vedges[v].iter().any(|e| ef[e].len() == 1);
+        // Edges sharp in this step: sharpness at least 1.
+        let sharp: Vec<usize> = vedges[v]
             .iter()
-            .filter(|e| ef[*e].len() == 1)
+            .filter(|e| m.edge_sharpness(&ef, **e) >= 1.0)
             .map(|&(a, b)| if a == v { b } else { a })
             .collect();
-        let new = if !bnd.is_empty() {
-            if vfaces[v].len() == 1 {
-                p
-            } else {
-                mul(
-                    add(add(m.pts[bnd[0]], m.pts[bnd[1]]), mul(p, 6.0)),
-                    1.0 / 8.0,
-                )
-            }
+        let new = if m.vertex_sharpness(v, vfaces[v].len(), boundary) >= 1.0 || sharp.len() > 2 {
+            p
+        } else if sharp.len() == 2 {
+            mul(
+                add(add(m.pts[sharp[0]], m.pts[sharp[1]]), mul(p, 6.0)),
+                1.0 / 8.0,
+            )
         } else {
             let k = vfaces[v].len() as f64;
             let q = mul(
@@ -95,7 +127,7 @@ fn subdivide(m: &Mesh) -> Mesh {
     let mut eid = HashMap::new();
     for (&(a, b), fs) in &ef {
         let mid = mul(add(m.pts[a], m.pts[b]), 0.5);
-        let e = if fs.len() == 2 {
+        let e = if fs.len() == 2 && m.edge_sharpness(&ef, (a, b)) < 1.0 {
             mul(add(add(mid, mid), add(fp[fs[0]], fp[fs[1]])), 0.25)
         } else {
             mid
@@ -121,11 +153,38 @@ fn subdivide(m: &Mesh) -> Mesh {
         quads.push([e(q[3], q[0]), c, e(q[2], q[3]), q[3]]);
         origin.push((f, u0, v0 + h, h));
     }
-    Mesh { pts, quads, origin }
+    let mut sharp = HashMap::new();
+    for (&(a, b), &s) in &m.sharp {
+        if decay(s) > 0.0 {
+            let mid = e(a, b);
+            sharp.insert((a.min(mid), a.max(mid)), decay(s));
+            sharp.insert((b.min(mid), b.max(mid)), decay(s));
+        }
+    }
+    let corner = m
+        .corner
+        .iter()
+        .filter(|(_, &s)| decay(s) > 0.0)
+        .map(|(&v, &s)| (v, decay(s)))
+        .collect();
+    Mesh {
+        pts,
+        quads,
+        origin,
+        sharp,
+        corner,
+        corners_interpolated: m.corners_interpolated,
+    }
 }
 
-/// Limit position of vertex `v` by the textbook masks.
-fn limit(m: &Mesh, ef: &HashMap<(usize, usize), Vec<usize>>, vquads: &[Vec<usize>], v: usize) -> P {
+/// Limit position of vertex `v` by the textbook masks; `None` at a dart (one sharp edge),
+/// whose limit has no such mask (the smooth one assumes smooth edges).
+fn limit(
+    m: &Mesh,
+    ef: &HashMap<(usize, usize), Vec<usize>>,
+    vquads: &[Vec<usize>],
+    v: usize,
+) -> Option<P> {
     let mut nbr = Vec::new();
     let mut diag = Vec::new();
     let mut faces = 0;
@@ -139,28 +198,33 @@ fn limit(m: &Mesh, ef: &HashMap<(usize, usize), Vec<usize>>, vquads: &[Vec<usize
     }
     nbr.sort_unstable();
     nbr.dedup();
-    let bnd: Vec<usize> = nbr
+    // Once every finite sharpness has run out, only infinitely sharp edges are left.
+    let sharp: Vec<usize> = nbr
         .iter()
         .copied()
-        .filter(|&w| ef[&(v.min(w), v.max(w))].len() == 1)
+        .filter(|&w| m.edge_sharpness(ef, (v.min(w), v.max(w))) > 0.0)
         .collect();
     let p = m.pts[v];
-    if !bnd.is_empty() {
-        if faces == 1 {
-            return p;
-        }
-        return mul(
-            add(add(m.pts[bnd[0]], m.pts[bnd[1]]), mul(p, 4.0)),
+    let boundary = nbr.iter().any(|&w| ef[&(v.min(w), v.max(w))].len() == 1);
+    if m.vertex_sharpness(v, faces, boundary) > 0.0 || sharp.len() > 2 {
+        return Some(p);
+    }
+    if sharp.len() == 2 {
+        return Some(mul(
+            add(add(m.pts[sharp[0]], m.pts[sharp[1]]), mul(p, 4.0)),
             1.0 / 6.0,
-        );
+        ));
+    }
+    if sharp.len() == 1 {
+        return None;
     }
     let n = faces as f64;
     let e = nbr.iter().fold([0.0; 3], |s, &w| add(s, m.pts[w]));
     let d = diag.iter().fold([0.0; 3], |s, &w| add(s, m.pts[w]));
-    mul(
+    Some(mul(
         add(add(mul(p, n * n), mul(e, 4.0)), d),
         1.0 / (n * (n + 5.0)),
-    )
+    ))
 }
 
 fn cage(mesh: &TMesh) -> Mesh {
@@ -175,7 +239,23 @@ fn cage(mesh: &TMesh) -> Mesh {
         .map(|f| [0, 1, 2, 3].map(|k| f.vertices[k] as usize))
         .collect();
     let origin = (0..loops.len()).map(|f| (f, 0.0, 0.0, 1.0)).collect();
-    Mesh { pts, quads, origin }
+    let tags = mesh.tags();
+    Mesh {
+        pts,
+        quads,
+        origin,
+        sharp: tags
+            .creases
+            .iter()
+            .map(|(&(a, b), &s)| ((a as usize, b as usize), s))
+            .collect(),
+        corner: tags
+            .corners
+            .iter()
+            .map(|(&v, &s)| (v as usize, s))
+            .collect(),
+        corners_interpolated: tags.boundary == tspath::tmesh::BoundaryInterpolation::EdgeAndCorner,
+    }
 }
 
 /// Worst distance between the library's limit surface and the subdivided cage's limit
@@ -204,13 +284,19 @@ fn worst_relative_error(model: &tspath::Model, levels: usize) -> f64 {
     let mut seen = vec![false; m.pts.len()];
     for (qi, q) in m.quads.iter().enumerate() {
         let v = q[0];
+        let (f, u0, v0, _) = m.origin[qi];
+        // (A hole's quads have no surface; their corners are checked from other faces.)
+        let Some(&face) = face_index.get(&(f as u32)) else {
+            continue;
+        };
         if seen[v] {
             continue;
         }
         seen[v] = true;
-        let (f, u0, v0, _) = m.origin[qi];
-        let p = model.surface.subs(face_index[&(f as u32)], u0, v0);
-        worst = worst.max(dist([p.x, p.y, p.z], limit(&m, &ef, &vquads, v)) / size);
+        let p = model.surface.subs(face, u0, v0);
+        if let Some(l) = limit(&m, &ef, &vquads, v) {
+            worst = worst.max(dist([p.x, p.y, p.z], l) / size);
+        }
     }
     worst
 }
@@ -294,4 +380,118 @@ fn non_quad_cage_is_subdivided_once_to_the_same_limit() {
     // The limit of the corner-free closed prism lies strictly inside its hull.
     let b = m.surface.bbox();
     assert!(b.min[0] > 0.0 && b.max[0] < 2.0 && b.min[2] > 0.0 && b.max[2] < 2.0);
+}
+
+/// A sheet of `n` × `n` quads over [0, n]² with a bumpy height, vertices numbered from 0
+/// row by row (`j * (n + 1) + i`), as OBJ text.
+fn bumpy_sheet(n: usize) -> String {
+    let mut s = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64, j as f64);
+            s += &format!(
+                "v {x} {y} {}\n",
+                0.3 * (1.3 * x).sin() * (0.9 * y).cos() + 0.05 * x * y
+            );
+        }
+    }
+    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
+    for j in 0..n {
+        for i in 0..n {
+            s += &format!(
+                "f {} {} {} {}\n",
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j + 1)
+            );
+        }
+    }
+    s
+}
+
+#[test]
+fn creased_cube_matches_plain_subdivision() {
+    // Issue 20: the top face's loop infinitely sharp (vertices of valence 3 with two sharp
+    // edges follow the crease rule), one vertical edge sharp for 2 steps (making two top
+    // corners corners for 2 steps), a bottom corner tagged with sharpness 3.
+    let obj = format!(
+        "{CUBE_OBJ}t crease 5/1/0 4 5 6 7 4 10\nt crease 2/1/0 1 5 2\nt corner 1/1/0 3 3\n"
+    );
+    let m = obj_model(&obj);
+    assert_eq!(m.mesh.tags().creases.len(), 5);
+    let e = worst_relative_error(&m, 5);
+    println!("creased cube: worst relative error {e:.2e}");
+    assert!(e < 1e-12, "{e}");
+}
+
+#[test]
+fn semi_sharp_creases_and_darts_match_plain_subdivision() {
+    // Issue 20: "semi-sharp sharpness s behaves as s sharp subdivision steps then smooth
+    // ones". On a 6 × 6 sheet: a chain of sharpness 3 across, one of sharpness 1 crossing it,
+    // an infinitely sharp one ending inside (a dart at vertex 24), and a corner of sharpness 2.
+    let n = 6;
+    let v = |i: usize, j: usize| j * (n + 1) + i;
+    let chain = |pts: &[(usize, usize)]| {
+        pts.iter()
+            .map(|&(i, j)| v(i, j).to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let across: Vec<(usize, usize)> = (0..=n).map(|i| (i, 2)).collect();
+    let crossing: Vec<(usize, usize)> = (0..=n).map(|j| (4, j)).collect();
+    let dart = [(1, 5), (2, 5), (3, 5), (3, 4)];
+    let obj = format!(
+        "{}t crease {}/1/0 {} 3\nt crease {}/1/0 {} 1\nt crease 4/1/0 {} 10\nt corner 1/1/0 {} 2\n",
+        bumpy_sheet(n),
+        across.len(),
+        chain(&across),
+        crossing.len(),
+        chain(&crossing),
+        chain(&dart),
+        v(1, 1)
+    );
+    let m = obj_model(&obj);
+    let e = worst_relative_error(&m, 5);
+    println!("semi-sharp sheet: worst relative error {e:.2e}");
+    assert!(e < 1e-12, "{e}");
+    // The tags change the surface (the test would pass vacuously otherwise).
+    let plain = obj_model(&bumpy_sheet(n));
+    // Face 16 (i 4, j 2): its corner is where the two chains cross.
+    let probe = |m: &tspath::Model| m.surface.subs(2 * n + 4, 0.0, 0.0);
+    assert!((probe(&m) - probe(&plain)).norm() > 1e-3);
+}
+
+/// An OpenSubdiv regression shape (`tests/fixtures/opensubdiv`).
+fn opensubdiv_shape(name: &str) -> tspath::Model {
+    let path = format!(
+        "{}/tests/fixtures/opensubdiv/catmark_{name}.obj",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    obj_model(&std::fs::read_to_string(path).unwrap())
+}
+
+#[test]
+fn opensubdiv_shapes_with_whole_sharpness_match_plain_subdivision() {
+    // Issue 20: cages tagged by another tool (OpenSubdiv's regression shapes): creases of
+    // sharpness 2, 3 and 10, darts, corners of sharpness 2 and 10, boundaries edge-only and
+    // none, triangles. (The others have fractional sharpness: `tests/obj_tags.rs`.)
+    for name in [
+        "cube_creases0",
+        "dart_edgeonly",
+        "dart_edgecorner",
+        "edgeonly",
+        "edgenone",
+        "pyramid_creases0",
+        "tent_creases0",
+    ] {
+        let m = opensubdiv_shape(name);
+        assert!(!m.mesh.tags().is_plain(), "{name}");
+        let e = worst_relative_error(&m, 5);
+        println!(
+            "{name}: {}; worst relative error {e:.2e}",
+            m.mesh.tags().describe()
+        );
+        assert!(e < 1e-12, "{name}: {e}");
+    }
 }

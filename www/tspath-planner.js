@@ -913,6 +913,7 @@ export class TspathPlanner extends HTMLElement {
       ['Extraordinary points', int(s.extraordinary_points)],
       ['T-junctions', int(s.t_junctions)],
       ['Holes', int(s.holes)],
+      ...(s.subdivision_tags ? [['Subdivision tags', s.subdivision_tags]] : []),
       ['Smallest concave radius', concave ? mmSig(concave.radius_mm) : 'none (nothing concave)', concave ? concave.radius_mm : ''],
     ];
     this.#facts(this.$('summary'), rows.map(([k, v, raw]) => [k.toLowerCase().replace(/\W+/g, '-'), k, v, raw]));

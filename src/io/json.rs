@@ -7,20 +7,28 @@
 //!   "default_knot": 1.0,
 //!   "points": [[x, y, z, w], [x, y, z], ...],
 //!   "faces": [[a, b, c, d], {"vertices": [a, b, c, d, e], "corners": [0, 1, 3, 4]}, ...],
-//!   "knots": [[a, b, interval], ...]
+//!   "knots": [[a, b, interval], ...],
+//!   "creases": [[a, b, sharpness], ...], "corners": [[v, sharpness], ...],
+//!   "holes": [face, ...], "boundary": "edge-and-corner"
 //! }
 //! ```
 //! Points are control points (weight 1 when omitted). A face is a counter-clockwise vertex
 //! loop; a plain list is a quadrilateral, an object names which loop positions are the four
 //! corners (the others are T-junctions), the first corner starting side 0. `knots` gives the
 //! knot interval of edges between two vertices; unlisted edges get `default_knot`.
+//! The last four (Catmull–Clark subdivision tags, optional) are as OBJ `t` tags give them:
+//! sharpness 10 or more is infinitely sharp; `boundary` is `none`, `edge-only` or
+//! `edge-and-corner` (the default).
 //! `units` is one of `mm`, `cm`, `m`, `inch`; coordinates are scaled to millimetres on
 //! reading. The writer always writes millimetres, so reading what it wrote gives back the
 //! same numbers, bit for bit.
 
 use crate::error::{Error, Result};
 use crate::geom::Point3;
-use crate::tmesh::{control_point_problem, knot_problem, ControlPoint, FaceLoop, Scheme, TMesh};
+use crate::surface::sharpness::SHARPNESS_INFINITE_FROM;
+use crate::tmesh::{
+    control_point_problem, knot_problem, ControlPoint, FaceLoop, Scheme, SubdivTags, TMesh,
+};
 use serde_json::{json, Value};
 use std::collections::{HashMap, HashSet};
 
@@ -306,7 +314,8 @@ pub fn read(text: &str) -> Result<(TMesh, JsonMeta)> {
             knot_record.entry(key).or_insert(i);
         }
     }
-    let mesh = TMesh::try_new(points, &faces, &knots, default_knot, scheme)?;
+    let tags = read_tags(obj)?;
+    let mesh = TMesh::try_new(points, &faces, &knots, default_knot, scheme)?.with_tags(tags)?;
     Ok((mesh, JsonMeta { name, units }))
 }
 
@@ -373,6 +382,85 @@ pub fn write(mesh: &TMesh, name: &str) -> String {
         .map(|(a, b, k)| format!("    [{a}, {b}, {}]", num(k)))
         .collect();
     out.push_str(&knots.join(",\n"));
-    out.push_str("\n  ]\n}\n");
+    out.push_str("\n  ]");
+    let tags = mesh.tags();
+    if !tags.is_plain() {
+        // Infinite sharpness is written as the tag value that means it.
+        let sharp = |s: f64| num(s.min(SHARPNESS_INFINITE_FROM));
+        let creases: Vec<String> = tags
+            .creases
+            .iter()
+            .map(|(&(a, b), &s)| format!("[{a}, {b}, {}]", sharp(s)))
+            .collect();
+        let corners: Vec<String> = tags
+            .corners
+            .iter()
+            .map(|(&v, &s)| format!("[{v}, {}]", sharp(s)))
+            .collect();
+        out.push_str(&format!(
+            ",\n  \"creases\": [{}],\n  \"corners\": [{}],\n  \"holes\": {},\n  \"boundary\": {}",
+            creases.join(", "),
+            corners.join(", "),
+            json!(tags.holes),
+            serde_json::to_string(&tags.boundary).expect("enum serialises")
+        ));
+    }
+    out.push_str("\n}\n");
     out
+}
+
+/// The optional subdivision tags: `"creases": [[a, b, sharpness], ...]`, `"corners": [[v,
+/// sharpness], ...]`, `"holes": [face, ...]`, `"boundary": "none" | "edge-only" |
+/// "edge-and-corner"`.
+fn read_tags(obj: &serde_json::Map<String, Value>) -> Result<SubdivTags> {
+    let mut tags = SubdivTags::default();
+    let list = |key: &str| -> Result<Vec<Value>> {
+        match obj.get(key) {
+            None => Ok(Vec::new()),
+            Some(Value::Array(a)) => Ok(a.clone()),
+            Some(_) => Err(Error::parse(FORMAT, format!("\"{key}\""), "not an array")),
+        }
+    };
+    let entry = |key: &str, i: usize, v: &Value, n: usize| -> Result<Vec<f64>> {
+        let loc = format!("{key}[{i}]");
+        let a = v
+            .as_array()
+            .filter(|a| a.len() == n)
+            .ok_or_else(|| Error::parse(FORMAT, &loc, format!("expected {n} numbers")))?;
+        a.iter().map(|x| num(x, &loc)).collect()
+    };
+    let index = |x: f64, loc: String| -> Result<u32> {
+        if x >= 0.0 && x.fract() == 0.0 && x <= u32::MAX as f64 {
+            Ok(x as u32)
+        } else {
+            Err(Error::parse(FORMAT, loc, format!("{x} is not an index")))
+        }
+    };
+    for (i, v) in list("creases")?.iter().enumerate() {
+        let e = entry("creases", i, v, 3)?;
+        let (a, b) = (
+            index(e[0], format!("creases[{i}]"))?,
+            index(e[1], format!("creases[{i}]"))?,
+        );
+        tags.creases.insert((a.min(b), a.max(b)), e[2]);
+    }
+    for (i, v) in list("corners")?.iter().enumerate() {
+        let e = entry("corners", i, v, 2)?;
+        tags.corners
+            .insert(index(e[0], format!("corners[{i}]"))?, e[1]);
+    }
+    for (i, v) in list("holes")?.iter().enumerate() {
+        let loc = format!("holes[{i}]");
+        tags.holes.insert(index(num(v, &loc)?, loc)?);
+    }
+    if let Some(v) = obj.get("boundary") {
+        tags.boundary = serde_json::from_value(v.clone()).map_err(|_| {
+            Error::parse(
+                FORMAT,
+                "\"boundary\"",
+                format!("expected \"none\", \"edge-only\" or \"edge-and-corner\", found {v}"),
+            )
+        })?;
+    }
+    Ok(tags)
 }

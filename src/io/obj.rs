@@ -3,34 +3,43 @@
 //! interpolated, as OpenSubdiv does with edge-and-corner boundary interpolation.
 //!
 //! `v x y z [w]` and `f a b c ...` (also `a/t/n` forms and negative indices) are read;
-//! other records (`vt`, `vn`, `g`, `o`, `s`, `usemtl`, ...) are skipped. Subdivision tags
-//! (`t crease`, `t corner`, `t interpolateboundary`, `t hole`) are not applied yet: each is
-//! returned as a warning naming its line, so that a surface made smooth where the modeller
-//! marked it sharp is said, not hidden; any other `t` tag is refused. A cage with faces that
-//! are not quadrilaterals is subdivided once (which makes every face a quadrilateral and
-//! leaves the limit surface unchanged). Vertices no face uses are dropped.
+//! other records (`vt`, `vn`, `g`, `o`, `s`, `usemtl`, ...) are skipped. Subdivision tags are
+//! applied as OpenSubdiv reads them, `t name nint/nfloat/nstring args...` with vertices and
+//! faces counted from 0:
+//! - `t crease n/1/0 v0 v1 ... s` (or one sharpness per edge): the chain's edges get
+//!   sharpness `s` (semi-sharp below 10, infinitely sharp from 10);
+//! - `t corner n/1/0 v... s`: sharp vertices (interpolated from 10);
+//! - `t interpolateboundary 1/0/0 k`: 0 none (the faces at a boundary vertex carry no surface
+//!   unless all its boundary edges are tagged infinitely sharp),
+//!   1 edges and corners (the default), 2 edges only;
+//! - `t hole n/0/0 f...`: faces that carry no surface.
+//!
+//! Any other tag, or a malformed one, is refused naming its line. A cage with faces that are
+//! not quadrilaterals is subdivided once with the same rules (which makes every face a
+//! quadrilateral and leaves the limit surface unchanged). Vertices no face uses are dropped.
 
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector4};
-use crate::tmesh::{control_point_problem, ControlPoint, FaceLoop, Scheme, TMesh};
+use crate::surface::sharpness::{self, EdgeEnd, INFINITELY_SHARP};
+use crate::tmesh::{
+    control_point_problem, BoundaryInterpolation, ControlPoint, FaceLoop, Scheme, SubdivTags, TMesh,
+};
 use std::collections::{HashMap, HashSet};
 
 const FORMAT: &str = "obj";
 
-/// The subdivision tags OBJ cages from modelling tools carry.
+/// The subdivision tags OBJ cages from modelling tools carry (as OpenSubdiv reads them).
 const KNOWN_TAGS: [&str; 4] = ["crease", "corner", "interpolateboundary", "hole"];
 
-/// Reads an OBJ cage. Coordinates are taken as millimetres. Returns the mesh and a warning
-/// per kind of subdivision tag the file has that is not applied (with its count and first
-/// line).
+/// Reads an OBJ cage with its subdivision tags. Coordinates are taken as millimetres. Returns
+/// the mesh and the warnings reading it gave (none at present).
 ///
 /// Errors name the line at fault, with vertices numbered as in the file (from 1): bad
 /// records, unknown `t` tags, and the topology a surface cannot have (an edge shared by more
 /// than two faces, neighbouring faces oriented inconsistently, faces meeting only at a
 /// vertex).
 pub fn read(text: &str) -> Result<(TMesh, Vec<String>)> {
-    // Tag name -> (count, first line).
-    let mut tags: Vec<(&str, usize, usize)> = Vec::new();
+    let mut tags = FileTags::default();
     let mut pts: Vec<Vector4> = Vec::new();
     // Line (1-based) of each vertex and face record.
     let mut vertex_line: Vec<usize> = Vec::new();
@@ -106,7 +115,7 @@ pub fn read(text: &str) -> Result<(TMesh, Vec<String>)> {
             }
             Some("t") => {
                 let tag = words.next().unwrap_or("");
-                let Some(known) = KNOWN_TAGS.iter().find(|k| **k == tag) else {
+                if !KNOWN_TAGS.contains(&tag) {
                     return Err(Error::parse(
                         FORMAT,
                         loc(),
@@ -115,29 +124,14 @@ pub fn read(text: &str) -> Result<(TMesh, Vec<String>)> {
                             KNOWN_TAGS.join(", ")
                         ),
                     ));
-                };
-                match tags.iter_mut().find(|t| t.0 == *known) {
-                    Some(t) => t.1 += 1,
-                    None => tags.push((known, 1, ln + 1)),
                 }
+                let args = tag_args(tag, words).map_err(|why| Error::parse(FORMAT, loc(), why))?;
+                read_tag(tag, &args, ln + 1, &mut tags)
+                    .map_err(|why| Error::parse(FORMAT, loc(), why))?;
             }
             _ => {}
         }
     }
-    let warnings = tags
-        .iter()
-        .map(|(tag, n, line)| {
-            format!(
-                "the file's {n} `t {tag}` tag(s) (first at line {line}) are not applied: the surface is read as plain Catmull–Clark (smooth where the modeller marked {}); check it before cutting",
-                match *tag {
-                    "crease" => "creases",
-                    "corner" => "sharp corners",
-                    "hole" => "holes, which are surfaced",
-                    _ => "how the boundary is interpolated",
-                }
-            )
-        })
-        .collect();
     if faces.is_empty() {
         return Err(Error::parse(
             FORMAT,
@@ -146,6 +140,7 @@ pub fn read(text: &str) -> Result<(TMesh, Vec<String>)> {
         ));
     }
     check_topology(&faces, &face_line, &vertex_line)?;
+    let cage_tags = tags.resolve(&faces, pts.len())?;
     // Drop unused vertices.
     let mut map: HashMap<u32, u32> = HashMap::new();
     let mut used = Vec::new();
@@ -157,10 +152,26 @@ pub fn read(text: &str) -> Result<(TMesh, Vec<String>)> {
             });
         }
     }
-    let (pts, faces) = if faces.iter().all(|f| f.len() == 4) {
-        (used, faces)
+    let cage_tags = SubdivTags {
+        creases: cage_tags
+            .creases
+            .iter()
+            .map(|(&(a, b), &s)| {
+                let (a, b) = (map[&a], map[&b]);
+                ((a.min(b), a.max(b)), s)
+            })
+            .collect(),
+        corners: cage_tags
+            .corners
+            .iter()
+            .filter_map(|(v, &s)| Some((*map.get(v)?, s)))
+            .collect(),
+        ..cage_tags
+    };
+    let (pts, faces, cage_tags) = if faces.iter().all(|f| f.len() == 4) {
+        (used, faces, cage_tags)
     } else {
-        subdivide_polygons(&used, &faces)?
+        subdivide_polygons(&used, &faces, &cage_tags)?
     };
     let points = pts
         .iter()
@@ -173,8 +184,223 @@ pub fn read(text: &str) -> Result<(TMesh, Vec<String>)> {
         .iter()
         .map(|f| FaceLoop::quad(f[0], f[1], f[2], f[3]))
         .collect();
-    let mesh = TMesh::try_new(points, &loops, &HashMap::new(), 1.0, Scheme::CatmullClark)?;
-    Ok((mesh, warnings))
+    let mesh = TMesh::try_new(points, &loops, &HashMap::new(), 1.0, Scheme::CatmullClark)?
+        .with_tags(cage_tags)?;
+    Ok((mesh, Vec::new()))
+}
+
+/// The `t` tags of a file as read, with the line of each, before they are checked against
+/// the cage.
+#[derive(Default)]
+struct FileTags {
+    /// `(a, b, sharpness, line)`, vertices counted from 0 as in the file.
+    creases: Vec<(u32, u32, f64, usize)>,
+    corners: Vec<(u32, f64, usize)>,
+    /// `(face, line)`, faces counted from 0 in file order.
+    holes: Vec<(u32, usize)>,
+    boundary: Option<(BoundaryInterpolation, usize)>,
+}
+
+/// Arguments of a `t` tag: `nint/nfloat/nstring` then that many integers, numbers and
+/// strings.
+struct TagArgs {
+    ints: Vec<i64>,
+    floats: Vec<f64>,
+}
+
+fn tag_args<'a>(
+    tag: &str,
+    mut words: impl Iterator<Item = &'a str>,
+) -> std::result::Result<TagArgs, String> {
+    let counts = words.next().unwrap_or("");
+    let n: Vec<usize> = counts
+        .split('/')
+        .map(|c| c.parse::<usize>())
+        .collect::<std::result::Result<_, _>>()
+        .ok()
+        .filter(|n: &Vec<usize>| n.len() == 3)
+        .ok_or_else(|| {
+            format!("`t {tag}` needs its argument counts as `ints/floats/strings` (e.g. `t crease 2/1/0 4 5 2.0`), found `{counts}`")
+        })?;
+    let rest: Vec<&str> = words.collect();
+    if rest.len() != n[0] + n[1] + n[2] {
+        return Err(format!(
+            "`t {tag} {counts}` announces {} arguments but {} follow",
+            n[0] + n[1] + n[2],
+            rest.len()
+        ));
+    }
+    let ints = rest[..n[0]]
+        .iter()
+        .map(|w| {
+            w.parse::<i64>()
+                .map_err(|_| format!("`t {tag}`: `{w}` is not an integer"))
+        })
+        .collect::<std::result::Result<_, _>>()?;
+    let floats = rest[n[0]..n[0] + n[1]]
+        .iter()
+        .map(|w| {
+            w.parse::<f64>()
+                .ok()
+                .filter(|x| !x.is_nan())
+                .ok_or_else(|| format!("`t {tag}`: `{w}` is not a number"))
+        })
+        .collect::<std::result::Result<_, _>>()?;
+    Ok(TagArgs { ints, floats })
+}
+
+/// Adds one tag's meaning to `tags`; errors say what is wrong with it.
+fn read_tag(
+    tag: &str,
+    a: &TagArgs,
+    line: usize,
+    tags: &mut FileTags,
+) -> std::result::Result<(), String> {
+    let index = |i: i64, what: &str| -> std::result::Result<u32, String> {
+        u32::try_from(i)
+            .map_err(|_| format!("`t {tag}`: {what} {i} is negative (tags count {what}s from 0)"))
+    };
+    // One sharpness for all, or one per item.
+    let sharpness = |k: usize, items: usize| -> std::result::Result<f64, String> {
+        let s = match a.floats.len() {
+            1 => a.floats[0],
+            n if n == items => a.floats[k],
+            n => {
+                return Err(format!(
+                "`t {tag}` has {n} sharpness values for {items} item(s): give one, or one per item"
+            ))
+            }
+        };
+        if s < 0.0 {
+            return Err(format!("`t {tag}`: sharpness {s} is negative"));
+        }
+        Ok(s)
+    };
+    match tag {
+        "crease" => {
+            if a.ints.len() < 2 {
+                return Err("`t crease` needs a chain of at least two vertices and a sharpness (e.g. `t crease 2/1/0 4 5 2.0`)".into());
+            }
+            for k in 0..a.ints.len() - 1 {
+                let (p, q) = (index(a.ints[k], "vertex")?, index(a.ints[k + 1], "vertex")?);
+                tags.creases
+                    .push((p, q, sharpness(k, a.ints.len() - 1)?, line));
+            }
+        }
+        "corner" => {
+            if a.ints.is_empty() {
+                return Err("`t corner` needs at least one vertex and a sharpness (e.g. `t corner 1/1/0 7 10.0`)".into());
+            }
+            for (k, &v) in a.ints.iter().enumerate() {
+                tags.corners
+                    .push((index(v, "vertex")?, sharpness(k, a.ints.len())?, line));
+            }
+        }
+        "hole" => {
+            if a.ints.is_empty() || !a.floats.is_empty() {
+                return Err("`t hole` takes face numbers only (e.g. `t hole 2/0/0 3 8`)".into());
+            }
+            for &f in &a.ints {
+                tags.holes.push((index(f, "face")?, line));
+            }
+        }
+        _ => {
+            let mode = match (a.ints.as_slice(), a.floats.len()) {
+                ([0], 0) => BoundaryInterpolation::None,
+                ([1], 0) => BoundaryInterpolation::EdgeAndCorner,
+                ([2], 0) => BoundaryInterpolation::EdgeOnly,
+                _ => {
+                    return Err("`t interpolateboundary` takes one integer: 0 none, 1 edges and corners, 2 edges only (e.g. `t interpolateboundary 1/0/0 1`)".into())
+                }
+            };
+            tags.boundary = Some((mode, line));
+        }
+    }
+    Ok(())
+}
+
+impl FileTags {
+    /// The tags checked against the cage's faces and `nv` vertices (file numbering), errors
+    /// naming the tag's line.
+    fn resolve(&self, faces: &[Vec<u32>], nv: usize) -> Result<SubdivTags> {
+        let at = |line: usize| format!("line {line}");
+        let mut edges: HashSet<(u32, u32)> = HashSet::new();
+        for f in faces {
+            for k in 0..f.len() {
+                let (a, b) = (f[k], f[(k + 1) % f.len()]);
+                edges.insert((a.min(b), a.max(b)));
+            }
+        }
+        let vertex = |v: u32, line: usize| -> Result<()> {
+            if (v as usize) < nv {
+                Ok(())
+            } else {
+                Err(Error::parse(
+                    FORMAT,
+                    at(line),
+                    format!("vertex {v} is not in the file (tags count vertices from 0; there are {nv})"),
+                ))
+            }
+        };
+        let mut out = SubdivTags::default();
+        for &(a, b, s, line) in &self.creases {
+            vertex(a, line)?;
+            vertex(b, line)?;
+            let key = (a.min(b), a.max(b));
+            if !edges.contains(&key) {
+                return Err(Error::parse(
+                    FORMAT,
+                    at(line),
+                    format!("`t crease`: vertices {a} and {b} (counted from 0) are not joined by an edge of any face"),
+                ));
+            }
+            out.creases.insert(key, sharpness::from_tag(s));
+        }
+        for &(v, s, line) in &self.corners {
+            vertex(v, line)?;
+            out.corners.insert(v, sharpness::from_tag(s));
+        }
+        for &(f, line) in &self.holes {
+            if f as usize >= faces.len() {
+                return Err(Error::parse(
+                    FORMAT,
+                    at(line),
+                    format!(
+                        "`t hole`: face {f} is not in the file (tags count faces from 0; there are {})",
+                        faces.len()
+                    ),
+                ));
+            }
+            out.holes.insert(f);
+        }
+        if let Some((mode, _)) = self.boundary {
+            out.boundary = mode;
+        }
+        if out.boundary == BoundaryInterpolation::None {
+            // Faces touching the boundary carry no surface: find them on the cage, before
+            // any polygon is split.
+            let mut edge_count: HashMap<(u32, u32), usize> = HashMap::new();
+            for f in faces {
+                for k in 0..f.len() {
+                    let (a, b) = (f[k], f[(k + 1) % f.len()]);
+                    *edge_count.entry((a.min(b), a.max(b))).or_default() += 1;
+                }
+            }
+            // OpenSubdiv's rule: the faces at a boundary vertex carry no surface unless all
+            // its boundary edges are tagged infinitely sharp.
+            let on_boundary: HashSet<u32> = edge_count
+                .iter()
+                .filter(|(e, &n)| n == 1 && out.creases.get(e) != Some(&INFINITELY_SHARP))
+                .flat_map(|(&(a, b), _)| [a, b])
+                .collect();
+            for (fi, f) in faces.iter().enumerate() {
+                if f.iter().any(|v| on_boundary.contains(v)) {
+                    out.holes.insert(fi as u32);
+                }
+            }
+        }
+        Ok(out)
+    }
 }
 
 /// "lines 3 and 7", "lines 3, 7 and 9".
@@ -295,12 +521,16 @@ fn check_topology(faces: &[Vec<u32>], face_line: &[usize], vertex_line: &[usize]
     Ok(())
 }
 
-/// One Catmull–Clark step on a polygon mesh (homogeneous points), with sharp boundaries and
-/// interpolated corners. Every face becomes quadrilaterals.
+/// One Catmull–Clark step on a polygon mesh (homogeneous points) with its subdivision tags:
+/// boundaries sharp, creases and corners by [`sharpness`]'s rules, corners (boundary vertices
+/// with one face) interpolated unless the boundary is interpolated at edges only. Every face
+/// becomes quadrilaterals (face `f`'s children are consecutive, one per corner); returns the
+/// fine mesh and its tags (creases decayed by one step, holes passed to the children).
 pub fn subdivide_polygons(
     pts: &[Vector4],
     faces: &[Vec<u32>],
-) -> Result<(Vec<Vector4>, Vec<Vec<u32>>)> {
+    tags: &SubdivTags,
+) -> Result<(Vec<Vector4>, Vec<Vec<u32>>, SubdivTags)> {
     let nv = pts.len();
     let mut edge_faces: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
     let mut edges: Vec<(u32, u32)> = Vec::new();
@@ -336,23 +566,47 @@ pub fn subdivide_polygons(
         vertex_edges[a as usize].push((a, b));
         vertex_edges[b as usize].push((a, b));
     }
+    let sharpness_of = |e: &(u32, u32)| {
+        if edge_faces[e].len() == 1 {
+            INFINITELY_SHARP
+        } else {
+            tags.creases.get(e).copied().unwrap_or(0.0)
+        }
+    };
+    let corner_rule = tags.boundary == BoundaryInterpolation::EdgeAndCorner;
+    let vertex_sharpness = |v: u32| {
+        let boundary = vertex_edges[v as usize]
+            .iter()
+            .any(|e| edge_faces[e].len() == 1);
+        if corner_rule && boundary && vertex_faces[v as usize].len() == 1 {
+            INFINITELY_SHARP
+        } else {
+            tags.corners.get(&v).copied().unwrap_or(0.0)
+        }
+    };
     let mut out = Vec::with_capacity(nv + edges.len() + faces.len());
     for v in 0..nv as u32 {
         let p = pts[v as usize];
         let incident = &vertex_edges[v as usize];
-        let boundary: Vec<u32> = incident
+        let open = incident
             .iter()
-            .filter(|e| edge_faces[e].len() == 1)
-            .map(|&(a, b)| if a == v { b } else { a })
+            .filter(|e| edge_faces[*e].len() == 1)
+            .count();
+        if open != 0 && open != 2 {
+            return Err(Error::InvalidMesh(format!(
+                "vertex {v} touches the boundary {} times (non-manifold)",
+                open / 2
+            )));
+        }
+        let ends: Vec<EdgeEnd> = incident
+            .iter()
+            .map(|e| EdgeEnd {
+                point: pts[(if e.0 == v { e.1 } else { e.0 }) as usize],
+                sharpness: sharpness_of(e),
+            })
             .collect();
-        let nf = vertex_faces[v as usize].len();
-        let new = if boundary.len() == 2 {
-            if nf == 1 {
-                p
-            } else {
-                (pts[boundary[0] as usize] + pts[boundary[1] as usize] + p * 6.0) / 8.0
-            }
-        } else if boundary.is_empty() {
+        let smooth = || {
+            let nf = vertex_faces[v as usize].len();
             let n = incident.len() as f64;
             let q = vertex_faces[v as usize]
                 .iter()
@@ -365,33 +619,59 @@ pub fn subdivide_polygons(
                 .sum::<Vector4>()
                 / n;
             (q + r * 2.0 + p * (n - 3.0)) / n
-        } else {
-            return Err(Error::InvalidMesh(format!(
-                "vertex {v} touches the boundary {} times (non-manifold)",
-                boundary.len() / 2
-            )));
         };
-        out.push(new);
+        out.push(sharpness::vertex_point(
+            p,
+            vertex_sharpness(v),
+            &ends,
+            smooth,
+        ));
     }
-    for &(a, b) in &edges {
-        let fs = &edge_faces[&(a, b)];
-        let mid = (pts[a as usize] + pts[b as usize]) * 0.5;
-        out.push(if fs.len() == 2 {
-            (mid * 2.0 + face_pts[fs[0] as usize] + face_pts[fs[1] as usize]) * 0.25
-        } else {
-            mid
-        });
+    for e in &edges {
+        let fs = &edge_faces[e];
+        let faces = (fs.len() == 2).then(|| (face_pts[fs[0] as usize], face_pts[fs[1] as usize]));
+        out.push(sharpness::edge_point(
+            pts[e.0 as usize],
+            pts[e.1 as usize],
+            faces,
+            sharpness_of(e),
+        ));
     }
     out.extend(face_pts.iter().copied());
     let ev = |a: u32, b: u32| nv as u32 + edge_index[&(a.min(b), a.max(b))];
     let mut quads = Vec::new();
+    let mut holes = std::collections::BTreeSet::new();
     for (fi, f) in faces.iter().enumerate() {
         let c = (nv + edges.len() + fi) as u32;
         let n = f.len();
         for k in 0..n {
+            if tags.holes.contains(&(fi as u32)) {
+                holes.insert(quads.len() as u32);
+            }
             let (prev, v, next) = (f[(k + n - 1) % n], f[k], f[(k + 1) % n]);
             quads.push(vec![v, ev(v, next), c, ev(prev, v)]);
         }
     }
-    Ok((out, quads))
+    let mut creases = std::collections::BTreeMap::new();
+    for (&(a, b), &s) in &tags.creases {
+        let s = sharpness::decayed(s);
+        if s > 0.0 {
+            let e = ev(a, b);
+            creases.insert((a.min(e), a.max(e)), s);
+            creases.insert((b.min(e), b.max(e)), s);
+        }
+    }
+    let corners = tags
+        .corners
+        .iter()
+        .map(|(&v, &s)| (v, sharpness::decayed(s)))
+        .filter(|&(_, s)| s > 0.0)
+        .collect();
+    let fine = SubdivTags {
+        creases,
+        corners,
+        holes,
+        boundary: tags.boundary,
+    };
+    Ok((out, quads, fine))
 }

@@ -122,6 +122,43 @@ fn find(parent: &mut [usize], mut x: usize) -> usize {
     x
 }
 
+/// Angles (quarter turns) of the sectors of surface-carrying faces round `v` (its outgoing
+/// half-edges `out`, in order), split where `crease` says an edge is a crease and at faces
+/// `is_domain` says carry no surface.
+fn crease_sectors(
+    mesh: &TMesh,
+    v: u32,
+    out: &[u32],
+    crease: &dyn Fn(u32) -> bool,
+    is_domain: &dyn Fn(u32) -> bool,
+) -> Vec<u32> {
+    // Between the faces of out[i - 1] and out[i] lies the edge out[i]. A boundary vertex's
+    // list starts at the boundary and does not wrap; an interior one starts after a crease.
+    let n = out.len();
+    let start = if mesh.is_boundary_vertex(v) {
+        0
+    } else {
+        (0..n).find(|&i| crease(out[i])).unwrap_or(0)
+    };
+    let mut sectors = Vec::new();
+    let mut cur = 0;
+    for k in 0..n {
+        let h = out[(start + k) % n];
+        if k > 0 && crease(h) {
+            sectors.push(cur);
+            cur = 0;
+        }
+        if is_domain(mesh.he(h).face) {
+            cur += mesh.sector_quarters(h);
+        } else if cur > 0 {
+            sectors.push(cur);
+            cur = 0;
+        }
+    }
+    sectors.push(cur);
+    sectors
+}
+
 /// Placement of a face in a chart: `chart = rot(k)·local + offset`.
 type Placement = (u8, [f64; 2]);
 
@@ -136,11 +173,21 @@ impl PatchLayout {
             .collect();
         let is_domain = |f: u32| domain.contains_key(&f);
         let nv = mesh.vertex_count() as u32;
-        // Vertices on the domain's boundary: on the mesh boundary or next to a face that
-        // carries no surface.
+        // Infinitely sharp creases (tagged Catmull–Clark edges) bound patches like the
+        // boundary does: the surface folds there.
+        let crease = |h: u32| {
+            let e = mesh.he(h);
+            mesh.edge_sharpness(e.origin, mesh.he(e.next).origin) == f64::INFINITY
+        };
+        let creased: Vec<bool> = (0..nv)
+            .map(|v| !mesh.tags().creases.is_empty() && mesh.outgoing(v).into_iter().any(crease))
+            .collect();
+        // Vertices on the domain's boundary: on the mesh boundary, next to a face that
+        // carries no surface, or on a crease.
         let on_boundary: Vec<bool> = (0..nv)
             .map(|v| {
-                mesh.is_boundary_vertex(v)
+                creased[v as usize]
+                    || mesh.is_boundary_vertex(v)
                     || mesh
                         .outgoing(v)
                         .iter()
@@ -155,26 +202,48 @@ impl PatchLayout {
                 .sum()
         };
         let extraordinary: Vec<bool> = (0..nv).map(|v| mesh.is_extraordinary(v)).collect();
-        let seeds: Vec<u32> = (0..nv)
-            .filter(|&v| {
-                extraordinary[v as usize] || (on_boundary[v as usize] && domain_angle(v) == 3)
-            })
-            .collect();
+        // Where lines start, and along which edges: every edge into the domain from an
+        // extraordinary point or a concave corner (of the boundary or between creases); the
+        // edge straight on from where a crease ends inside (a dart).
+        let mut seeds: Vec<(u32, Vec<u32>)> = Vec::new();
+        for v in 0..nv {
+            let out = mesh.outgoing(v);
+            let inward = |h: &&u32| {
+                let e = mesh.he(**h);
+                is_domain(e.face)
+                    && e.twin.is_some_and(|t| is_domain(mesh.he(t).face))
+                    && !crease(**h)
+            };
+            let all = || out.iter().filter(inward).copied().collect::<Vec<u32>>();
+            let (x, b) = (extraordinary[v as usize], on_boundary[v as usize]);
+            if x || (b && !creased[v as usize] && domain_angle(v) == 3) {
+                seeds.push((v, all()));
+            } else if creased[v as usize] {
+                let creases: Vec<usize> = (0..out.len()).filter(|&i| crease(out[i])).collect();
+                if creases.len() == 1 && !mesh.is_boundary_vertex(v) && out.len() == 4 {
+                    seeds.push((v, vec![out[(creases[0] + 2) % 4]]));
+                } else if crease_sectors(mesh, v, &out, &crease, &is_domain).contains(&3) {
+                    seeds.push((v, all()));
+                }
+            }
+        }
 
         // Trace the lines.
         let mut on_cut = vec![false; nv as usize];
         let mut cut_edges: HashSet<u32> = HashSet::new();
         let mut face_cuts: Vec<(Vec<f64>, Vec<f64>)> =
             vec![(Vec::new(), Vec::new()); surface.faces().len()];
-        for &v in &seeds {
+        for (hi, _) in mesh.half_edges().iter().enumerate() {
+            if creased[mesh.half_edges()[hi].origin as usize] && crease(hi as u32) {
+                cut_edges.insert(hi as u32);
+            }
+        }
+        for &(v, _) in &seeds {
             on_cut[v as usize] = true;
         }
-        for &v in &seeds {
-            for h in mesh.outgoing(v) {
-                let e = mesh.he(h);
-                let interior =
-                    is_domain(e.face) && e.twin.is_some_and(|t| is_domain(mesh.he(t).face));
-                if !interior || cut_edges.contains(&h) {
+        for (_, edges) in &seeds {
+            for &h in edges {
+                if cut_edges.contains(&h) {
                     continue;
                 }
                 let steps = {

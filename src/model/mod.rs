@@ -80,6 +80,9 @@ pub struct ModelSummary {
     pub t_junctions: usize,
     pub extraordinary_points: usize,
     pub holes: usize,
+    /// The cage's subdivision tags in words ("3 sharp crease edges, 1 corner, ..."); empty
+    /// when it has none.
+    pub subdivision_tags: String,
     pub patches: usize,
     pub bbox_mm: Aabb,
     /// The smallest concave radius (mm) and where: the largest ball that reaches everywhere
@@ -294,6 +297,7 @@ impl Model {
                 .filter(|&v| self.mesh.is_extraordinary(v))
                 .count(),
             holes: self.mesh.boundary_loops().saturating_sub(1),
+            subdivision_tags: self.mesh.tags().describe(),
             patches: self.layout.len(),
             bbox_mm: self.surface.bbox(),
             smallest_concave_radius: self.smallest_concave_radius(),

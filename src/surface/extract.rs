@@ -8,10 +8,11 @@
 
 use super::basis::bspline_bernstein;
 use super::bezier::BezierPatch;
+use super::sharpness::INFINITELY_SHARP;
 use super::subdiv::LocalMesh;
 use super::{FaceForm, FaceSurface};
 use crate::error::{Error, Result};
-use crate::tmesh::{Scheme, TMesh, KNOT_MATCH_REL};
+use crate::tmesh::{BoundaryInterpolation, Scheme, TMesh, KNOT_MATCH_REL};
 use std::collections::{HashMap, HashSet};
 
 pub(super) fn extract(mesh: &TMesh) -> Result<Vec<FaceSurface>> {
@@ -25,7 +26,7 @@ pub(super) fn extract(mesh: &TMesh) -> Result<Vec<FaceSurface>> {
     };
     let mut out = Vec::new();
     for (f, face) in mesh.faces().iter().enumerate() {
-        if !face.is_domain() {
+        if !mesh.carries_surface(f as u32) {
             continue;
         }
         let form = if by_subdivision.contains(&(f as u32)) {
@@ -153,7 +154,7 @@ fn local_one_ring(mesh: &TMesh, f: u32) -> Result<(LocalMesh, u32)> {
     let mut map: HashMap<u32, u32> = HashMap::new();
     let mut pts = Vec::new();
     let mut quads = Vec::with_capacity(faces.len());
-    let mut sharp = HashSet::new();
+    let mut creases = HashMap::new();
     for &g in &faces {
         let hs = mesh.face_half_edges(g);
         if hs.len() != 4 {
@@ -170,13 +171,34 @@ fn local_one_ring(mesh: &TMesh, f: u32) -> Result<(LocalMesh, u32)> {
             });
         }
         for (k, &h) in hs.iter().enumerate() {
-            if mesh.he(h).twin.is_none() {
+            let e = mesh.he(h);
+            let s = if e.twin.is_none() {
+                INFINITELY_SHARP
+            } else {
+                mesh.edge_sharpness(e.origin, mesh.he(e.next).origin)
+            };
+            if s > 0.0 {
                 let (a, b) = (quad[k], quad[(k + 1) % 4]);
-                sharp.insert((a.min(b), a.max(b)));
+                creases.insert((a.min(b), a.max(b)), s);
             }
         }
         quads.push(quad);
     }
+    // Tagged corners, and with edge-and-corner interpolation every boundary vertex with one
+    // face.
+    let corner_rule = mesh.tags().boundary == BoundaryInterpolation::EdgeAndCorner;
+    let corners = map
+        .iter()
+        .filter_map(|(&v, &local)| {
+            let one_face = corner_rule && mesh.is_boundary_vertex(v) && mesh.outgoing(v).len() == 1;
+            let s = if one_face {
+                INFINITELY_SHARP
+            } else {
+                mesh.tags().corners.get(&v).copied().unwrap_or(0.0)
+            };
+            (s > 0.0).then_some((local, s))
+        })
+        .collect();
     let q = faces
         .binary_search(&f)
         .expect("the face is in its own ring") as u32;
@@ -186,7 +208,8 @@ fn local_one_ring(mesh: &TMesh, f: u32) -> Result<(LocalMesh, u32)> {
             pts,
             origin,
             quads,
-            sharp,
+            creases,
+            corners,
         },
         q,
     ))

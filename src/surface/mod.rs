@@ -11,6 +11,7 @@ pub mod basis;
 pub mod bezier;
 pub mod diffgeom;
 mod extract;
+pub mod sharpness;
 pub mod subdiv;
 pub mod tessellate;
 

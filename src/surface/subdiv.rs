@@ -4,18 +4,21 @@
 //! below which the limit point stands for the whole (sub-nanometre) region.
 //!
 //! Rules (homogeneous coordinates, so rational cages subdivide as NURCCs): face points are
-//! face averages; interior edge points `(a + b + f0 + f1)/4`; interior vertex points
-//! `(Q + 2R + (n − 3)v)/n`. Boundary edges are sharp: edge points are midpoints, boundary
-//! vertices `(a + 6v + b)/8`, and a vertex with one face (a corner) stays where it is.
-//! A regular face (interior corners of valence 4, boundary corners with two faces, corners
-//! with one) is a uniform bicubic B-spline patch of its 16 one-ring points, with points
-//! mirrored across sharp boundaries (`2·p_boundary − p_inner`).
+//! face averages; smooth edge points `(a + b + f0 + f1)/4`; smooth vertex points
+//! `(Q + 2R + (n − 3)v)/n`. Boundary edges, creases and corners follow [`super::sharpness`]:
+//! sharp edge points are midpoints, crease vertices `(a + 6v + b)/8`, corners stay, and
+//! semi-sharp creases decay by one per step. A regular face (each corner smooth of valence
+//! 4, on an infinitely sharp crease or boundary with two faces on this side, or a corner with
+//! this face alone between its sharp edges; nothing semi-sharp) is a uniform bicubic B-spline
+//! patch of its 16 one-ring points, with points mirrored across infinitely sharp sides
+//! (`2·p_side − p_inner`).
 //!
 //! Owns: the local quad mesh, one subdivision step, regular-patch detection, the per-face
 //! quadtree of Bézier cells. Must not: know about T-junctions or knot intervals other than
 //! uniform ones (callers reject those near extraordinary points).
 
 use super::bezier::{BezierPatch, SurfaceDerivs};
+use super::sharpness::{self, EdgeEnd, VertexRule, INFINITELY_SHARP};
 use crate::geom::{Point3, Vector3, Vector4};
 use std::collections::HashMap;
 
@@ -35,8 +38,12 @@ pub struct LocalMesh {
     /// the region and keep their relative precision down to the deepest cells.
     pub origin: Vector3,
     pub quads: Vec<[u32; 4]>,
-    /// Undirected edges `(min, max)` that lie on the model's boundary.
-    pub sharp: std::collections::HashSet<(u32, u32)>,
+    /// Sharpness of the sharp undirected edges `(min, max)`: the model's boundary edges
+    /// ([`INFINITELY_SHARP`]) and its creases. An open edge not listed is where the cut
+    /// ended.
+    pub creases: HashMap<(u32, u32), f64>,
+    /// Sharpness of the sharp vertices (tagged or interpolated corners).
+    pub corners: HashMap<u32, f64>,
 }
 
 /// The quadtree of a face evaluated by subdivision.
@@ -217,15 +224,13 @@ impl Adjacency {
     }
 }
 
-/// How a vertex of a local mesh sits in the model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum VertexKind {
-    /// All its faces are in the local mesh and none of its edges is sharp.
-    Interior { faces: usize },
-    /// On the model's boundary, with all its faces present.
-    Boundary { faces: usize },
-    /// Some of its faces were cut away: its subdivision rule cannot be applied.
-    Incomplete,
+/// A vertex of a local mesh with everything its rules need.
+struct Around {
+    faces: usize,
+    /// Every edge at the vertex once: its far end and sharpness.
+    edges: Vec<(u32, f64)>,
+    /// False where some of its faces were cut away: its rules cannot be applied.
+    complete: bool,
 }
 
 fn edge_key(a: u32, b: u32) -> (u32, u32) {
@@ -233,9 +238,29 @@ fn edge_key(a: u32, b: u32) -> (u32, u32) {
 }
 
 impl LocalMesh {
-    fn vertex_kind(&self, adj: &Adjacency, v: u32) -> VertexKind {
+    /// Sharpness of the edge `a`–`b` (0 when smooth).
+    fn edge_sharpness(&self, a: u32, b: u32) -> f64 {
+        self.creases.get(&edge_key(a, b)).copied().unwrap_or(0.0)
+    }
+
+    fn vertex_sharpness(&self, v: u32) -> f64 {
+        self.corners.get(&v).copied().unwrap_or(0.0)
+    }
+
+    /// The quad holding the directed edge `(a, b)` (the one across that edge from a quad
+    /// running `b → a`) and the corner index of `a` in it; `None` where there is none or the
+    /// edge is infinitely sharp.
+    fn across(&self, adj: &Adjacency, a: u32, b: u32) -> Option<(u32, u8)> {
+        if self.edge_sharpness(a, b) == INFINITELY_SHARP {
+            return None;
+        }
+        adj.directed.get(&(a, b)).copied()
+    }
+
+    fn around(&self, adj: &Adjacency, v: u32) -> Around {
         let quads = &adj.vertex_quads[v as usize];
-        let mut sharp = 0;
+        let mut edges: Vec<(u32, f64)> = Vec::with_capacity(quads.len() + 1);
+        let mut complete = true;
         for &q in quads {
             let quad = &self.quads[q as usize];
             let k = quad
@@ -243,25 +268,90 @@ impl LocalMesh {
                 .position(|&x| x == v)
                 .expect("vertex is in its quad");
             for w in [quad[(k + 1) % 4], quad[(k + 3) % 4]] {
-                if adj.is_open(v, w) {
-                    if self.sharp.contains(&edge_key(v, w)) {
-                        sharp += 1;
-                    } else {
-                        return VertexKind::Incomplete;
-                    }
+                if edges.iter().any(|e| e.0 == w) {
+                    continue;
                 }
+                let s = self.edge_sharpness(v, w);
+                // An open edge is the model's boundary only if it is marked (infinitely sharp).
+                if adj.is_open(v, w) && s != INFINITELY_SHARP {
+                    complete = false;
+                }
+                edges.push((w, s));
             }
         }
-        match sharp {
-            0 => VertexKind::Interior { faces: quads.len() },
-            2 => VertexKind::Boundary { faces: quads.len() },
-            _ => VertexKind::Incomplete,
+        Around {
+            faces: quads.len(),
+            edges,
+            complete,
+        }
+    }
+
+    fn rule(&self, v: u32, a: &Around) -> VertexRule {
+        VertexRule::of(self.vertex_sharpness(v), a.edges.iter().map(|e| e.1))
+    }
+
+    /// Quads of the sector of `v` holding quad `q`: those reached from `q` round `v` without
+    /// crossing an edge that blocks.
+    fn sector_size(&self, adj: &Adjacency, q: u32, v: u32) -> usize {
+        let pos = |quad: u32| {
+            let qd = &self.quads[quad as usize];
+            (qd, qd.iter().position(|&x| x == v).expect("vertex in quad"))
+        };
+        let limit = adj.vertex_quads[v as usize].len();
+        let mut count = 1;
+        // Counter-clockwise: across each quad's side leaving `v`.
+        let mut cur = q;
+        while count < limit {
+            let (qd, k) = pos(cur);
+            let w = qd[(k + 1) % 4];
+            match self.across(adj, w, v) {
+                Some((n, _)) if n != q => {
+                    cur = n;
+                    count += 1;
+                }
+                Some(_) => return count,
+                None => break,
+            }
+        }
+        // Clockwise: across each quad's side arriving at `v`.
+        let mut cur = q;
+        while count < limit {
+            let (qd, k) = pos(cur);
+            let w = qd[(k + 3) % 4];
+            match self.across(adj, v, w) {
+                Some((n, _)) if n != q => {
+                    cur = n;
+                    count += 1;
+                }
+                _ => break,
+            }
+        }
+        count
+    }
+
+    /// True if corner `v` of quad `q` is regular for `q`: the uniform bicubic B-spline of the
+    /// one-ring (mirrored across infinitely sharp edges) is `q`'s limit there. A smooth
+    /// vertex of four faces, a crease vertex with two faces on `q`'s side of the crease, a
+    /// corner with `q` alone between its sharp edges; no semi-sharp edge or vertex.
+    fn regular_corner(&self, adj: &Adjacency, q: u32, v: u32) -> bool {
+        let a = self.around(adj, v);
+        let vs = self.vertex_sharpness(v);
+        let finite = |s: f64| s > 0.0 && s != INFINITELY_SHARP;
+        if !a.complete || finite(vs) || a.edges.iter().any(|e| finite(e.1)) {
+            return false;
+        }
+        match self.rule(v, &a) {
+            VertexRule::Smooth => a.faces == 4,
+            VertexRule::Dart => false,
+            VertexRule::Crease => self.sector_size(adj, q, v) == 2,
+            VertexRule::Corner => self.sector_size(adj, q, v) == 1,
         }
     }
 
     /// One Catmull–Clark step. Returns the fine mesh; quad `q` of `self` has children
     /// `4q..4q+4` ordered `[u low v low, u high v low, u high v high, u low v high]`, each with
-    /// its first corner at its own `(0, 0)` in the parent's frame.
+    /// its first corner at its own `(0, 0)` in the parent's frame. Creases and corners decay
+    /// by one step ([`sharpness::decayed`]).
     pub fn subdivide(&self) -> LocalMesh {
         let adj = Adjacency::new(self);
         let nv = self.pts.len();
@@ -285,54 +375,54 @@ impl LocalMesh {
             .collect();
         let mut pts = Vec::with_capacity(nv + ne + self.quads.len());
         // Vertex points.
+        let mut ends: Vec<EdgeEnd> = Vec::new();
         for v in 0..nv as u32 {
             let p = self.pts[v as usize];
-            let new = match self.vertex_kind(&adj, v) {
-                VertexKind::Interior { faces } => {
-                    let n = faces as f64;
-                    let quads = &adj.vertex_quads[v as usize];
-                    let q: Vector4 =
-                        quads.iter().map(|&f| face_pts[f as usize]).sum::<Vector4>() / n;
-                    let mut r = Vector4::zeros();
-                    for &f in quads {
-                        let quad = &self.quads[f as usize];
-                        let k = quad.iter().position(|&x| x == v).unwrap();
-                        // Each edge is shared by two of the quads: count the outgoing one.
-                        r += (p + self.pts[quad[(k + 1) % 4] as usize]) * 0.5;
-                    }
-                    r /= n;
-                    (q + r * 2.0 + p * (n - 3.0)) / n
+            let a = self.around(&adj, v);
+            if !a.complete {
+                pts.push(p);
+                continue;
+            }
+            ends.clear();
+            ends.extend(a.edges.iter().map(|&(w, s)| EdgeEnd {
+                point: self.pts[w as usize],
+                sharpness: s,
+            }));
+            let smooth = || {
+                let n = a.faces as f64;
+                let quads = &adj.vertex_quads[v as usize];
+                let q: Vector4 = quads.iter().map(|&f| face_pts[f as usize]).sum::<Vector4>() / n;
+                let mut r = Vector4::zeros();
+                for &f in quads {
+                    let quad = &self.quads[f as usize];
+                    let k = quad.iter().position(|&x| x == v).unwrap();
+                    // Each edge is shared by two of the quads: count the outgoing one.
+                    r += (p + self.pts[quad[(k + 1) % 4] as usize]) * 0.5;
                 }
-                VertexKind::Boundary { faces: 1 } => p,
-                VertexKind::Boundary { .. } => {
-                    let mut nb = Vector4::zeros();
-                    for &f in &adj.vertex_quads[v as usize] {
-                        let quad = &self.quads[f as usize];
-                        let k = quad.iter().position(|&x| x == v).unwrap();
-                        for w in [quad[(k + 1) % 4], quad[(k + 3) % 4]] {
-                            if adj.is_open(v, w) {
-                                nb += self.pts[w as usize];
-                            }
-                        }
-                    }
-                    (nb + p * 6.0) / 8.0
-                }
-                VertexKind::Incomplete => p,
+                r /= n;
+                (q + r * 2.0 + p * (n - 3.0)) / n
             };
-            pts.push(new);
+            pts.push(sharpness::vertex_point(
+                p,
+                self.vertex_sharpness(v),
+                &ends,
+                smooth,
+            ));
         }
         // Edge points.
         for &(a, b) in &edges {
-            let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
-            let fa = adj.directed.get(&(a, b));
-            let fb = adj.directed.get(&(b, a));
-            let e = match (fa, fb) {
+            let faces = match (adj.directed.get(&(a, b)), adj.directed.get(&(b, a))) {
                 (Some(&(q0, _)), Some(&(q1, _))) => {
-                    (pa + pb + face_pts[q0 as usize] + face_pts[q1 as usize]) * 0.25
+                    Some((face_pts[q0 as usize], face_pts[q1 as usize]))
                 }
-                _ => (pa + pb) * 0.5,
+                _ => None,
             };
-            pts.push(e);
+            pts.push(sharpness::edge_point(
+                self.pts[a as usize],
+                self.pts[b as usize],
+                faces,
+                self.edge_sharpness(a, b),
+            ));
         }
         pts.extend(face_pts.iter().copied());
         let ev = |a: u32, b: u32| nv as u32 + edge_id[&edge_key(a, b)];
@@ -346,19 +436,27 @@ impl LocalMesh {
             quads.push([f, e12, c2, e23]);
             quads.push([e30, f, e23, c3]);
         }
-        let mut sharp = std::collections::HashSet::new();
-        for &(a, b) in &self.sharp {
-            if let Some(&id) = edge_id.get(&(a, b)) {
+        let mut creases = HashMap::with_capacity(self.creases.len() * 2);
+        for (&(a, b), &s) in &self.creases {
+            let s = sharpness::decayed(s);
+            if let (Some(&id), true) = (edge_id.get(&(a, b)), s > 0.0) {
                 let e = nv as u32 + id;
-                sharp.insert(edge_key(a, e));
-                sharp.insert(edge_key(e, b));
+                creases.insert(edge_key(a, e), s);
+                creases.insert(edge_key(e, b), s);
             }
         }
+        let corners = self
+            .corners
+            .iter()
+            .map(|(&v, &s)| (v, sharpness::decayed(s)))
+            .filter(|&(_, s)| s > 0.0)
+            .collect();
         LocalMesh {
             pts,
             origin: self.origin,
             quads,
-            sharp,
+            creases,
+            corners,
         }
     }
 
@@ -397,10 +495,15 @@ impl LocalMesh {
                 })
             }));
         }
-        let sharp = self
-            .sharp
+        let creases = self
+            .creases
             .iter()
-            .filter_map(|&(a, b)| Some(edge_key(*map.get(&a)?, *map.get(&b)?)))
+            .filter_map(|(&(a, b), &s)| Some((edge_key(*map.get(&a)?, *map.get(&b)?), s)))
+            .collect();
+        let corners = self
+            .corners
+            .iter()
+            .filter_map(|(v, &s)| Some((*map.get(v)?, s)))
             .collect();
         let idx = keep.binary_search(&q).expect("q is in its own one-ring") as u32;
         (
@@ -408,7 +511,8 @@ impl LocalMesh {
                 pts,
                 origin: self.origin,
                 quads,
-                sharp,
+                creases,
+                corners,
             },
             idx,
         )
@@ -423,11 +527,8 @@ impl LocalMesh {
 
     fn regular_grid_with(&self, adj: &Adjacency, q: u32) -> Option<[[Vector4; 4]; 4]> {
         let quad = self.quads[q as usize];
-        for &c in &quad {
-            match self.vertex_kind(adj, c) {
-                VertexKind::Interior { faces: 4 } | VertexKind::Boundary { faces: 1 | 2 } => {}
-                _ => return None,
-            }
+        if !quad.iter().all(|&c| self.regular_corner(adj, q, c)) {
+            return None;
         }
         let mut g: [[Option<Vector4>; 4]; 4] = [[None; 4]; 4];
         // Corner k sits at grid (i, j); its outer quadrant points (a, diag, b).
@@ -446,20 +547,21 @@ impl LocalMesh {
             let (ci, cj) = CORNER[k];
             g[cj][ci] = Some(self.pts[p as usize]);
             let mut found: [Option<u32>; 3] = [None; 3];
-            // Counter-clockwise: the quad across the previous side, then the diagonal one.
-            if let Some(&(l, i)) = adj.directed.get(&(p, prev)) {
+            // Counter-clockwise: the quad across the previous side, then the diagonal one
+            // (never across an infinitely sharp edge: the other side is mirrored instead).
+            if let Some((l, i)) = self.across(adj, p, prev) {
                 let a = at(l, i as i32 - 1);
                 found[0] = Some(a);
-                if let Some(&(d, j)) = adj.directed.get(&(p, a)) {
+                if let Some((d, j)) = self.across(adj, p, a) {
                     found[1] = Some(at(d, j as i32 + 2));
                     found[2] = Some(at(d, j as i32 - 1));
                 }
             }
             // Clockwise: the quad across the next side, then the diagonal one.
-            if let Some(&(b_quad, i)) = adj.directed.get(&(next, p)) {
+            if let Some((b_quad, i)) = self.across(adj, next, p) {
                 let b = at(b_quad, i as i32 + 2);
                 found[2] = found[2].or(Some(b));
-                if let Some(&(d, j)) = adj.directed.get(&(b, p)) {
+                if let Some((d, j)) = self.across(adj, b, p) {
                     found[1] = found[1].or(Some(at(d, j as i32 + 3)));
                     found[0] = found[0].or(Some(at(d, j as i32 + 2)));
                 }
@@ -470,11 +572,11 @@ impl LocalMesh {
                 }
             }
         }
-        // Mirror across sharp sides: side 0 → row 0, side 1 → column 3, side 2 → row 3,
-        // side 3 → column 0.
+        // Mirror across sharp sides (model boundaries and infinitely sharp creases): side 0 →
+        // row 0, side 1 → column 3, side 2 → row 3, side 3 → column 0.
         let sharp_side = |k: usize| {
             let (a, b) = (quad[k], quad[(k + 1) % 4]);
-            adj.is_open(a, b) && self.sharp.contains(&edge_key(a, b))
+            self.edge_sharpness(a, b) == INFINITELY_SHARP
         };
         let sides = [sharp_side(0), sharp_side(1), sharp_side(2), sharp_side(3)];
         for _ in 0..3 {
@@ -513,39 +615,34 @@ impl LocalMesh {
         Some(out)
     }
 
-    /// The limit point of vertex `v` (homogeneous), whose faces must all be present.
+    /// The limit point of vertex `v` (homogeneous), whose faces must all be present. A
+    /// semi-sharp vertex or edge is taken as sharp (callers ask only once it is one or the
+    /// other, or for a nearby point).
     pub fn limit_point(&self, v: u32) -> Vector4 {
         let adj = Adjacency::new(self);
         let p = self.pts[v as usize];
-        match self.vertex_kind(&adj, v) {
-            VertexKind::Interior { faces } => {
-                let n = faces as f64;
-                let mut e = Vector4::zeros();
-                let mut f = Vector4::zeros();
-                for &q in &adj.vertex_quads[v as usize] {
-                    let quad = &self.quads[q as usize];
-                    let k = quad.iter().position(|&x| x == v).unwrap();
-                    e += self.pts[quad[(k + 1) % 4] as usize];
-                    f += self.pts[quad[(k + 2) % 4] as usize];
-                }
-                (p * (n * n) + e * 4.0 + f) / (n * (n + 5.0))
-            }
-            VertexKind::Boundary { faces: 1 } => p,
-            VertexKind::Boundary { .. } => {
-                let mut nb = Vector4::zeros();
-                for &q in &adj.vertex_quads[v as usize] {
-                    let quad = &self.quads[q as usize];
-                    let k = quad.iter().position(|&x| x == v).unwrap();
-                    for w in [quad[(k + 1) % 4], quad[(k + 3) % 4]] {
-                        if adj.is_open(v, w) {
-                            nb += self.pts[w as usize];
-                        }
-                    }
-                }
-                (nb + p * 4.0) / 6.0
-            }
-            VertexKind::Incomplete => p,
+        let a = self.around(&adj, v);
+        if !a.complete {
+            return p;
         }
+        let smooth = || {
+            let n = a.faces as f64;
+            let mut e = Vector4::zeros();
+            let mut f = Vector4::zeros();
+            for &q in &adj.vertex_quads[v as usize] {
+                let quad = &self.quads[q as usize];
+                let k = quad.iter().position(|&x| x == v).unwrap();
+                e += self.pts[quad[(k + 1) % 4] as usize];
+                f += self.pts[quad[(k + 2) % 4] as usize];
+            }
+            (p * (n * n) + e * 4.0 + f) / (n * (n + 5.0))
+        };
+        let ends = a
+            .edges
+            .iter()
+            .filter(|e| e.1 > 0.0)
+            .map(|e| self.pts[e.0 as usize]);
+        sharpness::limit_point(p, self.rule(v, &a), ends, smooth)
     }
 
     /// The quadtree of quad `q`: a Bézier cell if it is regular, else its children after
@@ -569,12 +666,7 @@ impl LocalMesh {
         let corner = quad
             .iter()
             .copied()
-            .find(|&c| {
-                !matches!(
-                    ring.vertex_kind(&adj, c),
-                    VertexKind::Interior { faces: 4 } | VertexKind::Boundary { faces: 1 | 2 }
-                )
-            })
+            .find(|&c| !ring.regular_corner(&adj, qi, c))
             .unwrap_or(quad[0]);
         let limit = ring.limit_point(corner);
         if depth >= MAX_DEPTH {

@@ -29,7 +29,7 @@ pub mod walk;
 use crate::error::{Error, Result};
 use crate::geom::{Aabb, Point3, Vector4};
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// How faces near extraordinary points and at boundaries are evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -39,8 +39,83 @@ pub enum Scheme {
     #[default]
     TSpline,
     /// Catmull–Clark limit surface (unit knot intervals; boundary edges sharp, corners
-    /// interpolated), as for OBJ cages.
+    /// interpolated unless [`SubdivTags::boundary`] says otherwise), as for OBJ cages.
     CatmullClark,
+}
+
+/// How a Catmull–Clark cage's boundary is interpolated (OpenSubdiv's vertex boundary
+/// interpolation; OBJ `t interpolateboundary`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoundaryInterpolation {
+    /// No surface over the faces at boundary vertices (except where all of a vertex's
+    /// boundary edges are tagged infinitely sharp).
+    None,
+    /// Boundary edges sharp; a boundary vertex with one face follows the crease rule (the
+    /// corner is rounded).
+    EdgeOnly,
+    /// Boundary edges sharp and corners (boundary vertices with one face) interpolated.
+    #[default]
+    EdgeAndCorner,
+}
+
+/// Subdivision tags of a Catmull–Clark cage: where the modeller made the surface sharp or
+/// left it open. Sharpness as [`crate::surface::sharpness`] reads it (0 smooth, infinite
+/// never decays).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SubdivTags {
+    /// Sharpness of creased edges, by undirected vertex pair `(min, max)`.
+    pub creases: BTreeMap<(u32, u32), f64>,
+    /// Sharpness of tagged corner vertices.
+    pub corners: BTreeMap<u32, f64>,
+    /// Faces that carry no surface (they still shape their neighbours).
+    pub holes: BTreeSet<u32>,
+    pub boundary: BoundaryInterpolation,
+}
+
+impl SubdivTags {
+    /// True if nothing is tagged and the boundary is interpolated as by default.
+    pub fn is_plain(&self) -> bool {
+        *self == SubdivTags::default()
+    }
+
+    /// The tags in words, for a person ("4 sharp crease edges, 2 semi-sharp, 1 corner, 1 hole
+    /// face, boundary edges only"); empty when plain.
+    pub fn describe(&self) -> String {
+        let plural =
+            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        let sharp = self.creases.values().filter(|s| s.is_infinite()).count();
+        let semi = self.creases.len() - sharp;
+        let mut parts = Vec::new();
+        if sharp > 0 {
+            parts.push(plural(sharp, "sharp crease edge", "sharp crease edges"));
+        }
+        if semi > 0 {
+            parts.push(plural(
+                semi,
+                "semi-sharp crease edge",
+                "semi-sharp crease edges",
+            ));
+        }
+        if !self.corners.is_empty() {
+            parts.push(plural(self.corners.len(), "sharp corner", "sharp corners"));
+        }
+        if !self.holes.is_empty() {
+            parts.push(plural(self.holes.len(), "hole face", "hole faces"));
+        }
+        match self.boundary {
+            BoundaryInterpolation::EdgeAndCorner => {}
+            BoundaryInterpolation::EdgeOnly => parts.push("boundary sharp at edges only".into()),
+            BoundaryInterpolation::None => parts.push("boundary not interpolated".into()),
+        }
+        parts.join(", ")
+    }
+
+    /// True if some crease is infinitely sharp: the limit surface has a crease (a C0 line)
+    /// along it.
+    pub fn has_sharp_creases(&self) -> bool {
+        self.creases.values().any(|s| s.is_infinite())
+    }
 }
 
 /// A rational control point: Cartesian position (mm) and weight.
@@ -119,6 +194,7 @@ pub struct TMesh {
     /// Per half-edge: part of a fan line (see the module notes), crossed by rays unseen.
     fan_line: Vec<bool>,
     scheme: Scheme,
+    tags: SubdivTags,
 }
 
 /// Relative tolerance (of the larger side) for comparing sums of knot intervals.
@@ -349,6 +425,7 @@ impl TMesh {
             vertex_edge,
             fan_line,
             scheme,
+            tags: SubdivTags::default(),
         };
         for v in 0..nv {
             let start = mesh.vertex_edge[v];
@@ -372,6 +449,118 @@ impl TMesh {
     /// Scheme used to evaluate the mesh.
     pub fn scheme(&self) -> Scheme {
         self.scheme
+    }
+
+    /// The same Catmull–Clark cage with its subdivision tags. Sharpness values are taken as
+    /// [`crate::surface::sharpness::from_tag`] reads them (10 and above infinite). With
+    /// [`BoundaryInterpolation::None`] the faces at a boundary vertex become holes unless
+    /// all the vertex's boundary edges are tagged infinitely sharp (as in OpenSubdiv). Errors
+    /// name the tag at fault: a crease that is not an edge, a vertex or face out of range, a
+    /// negative or non-finite sharpness, tags on a T-spline, or nothing left to carry
+    /// surface.
+    pub fn with_tags(mut self, mut tags: SubdivTags) -> Result<TMesh> {
+        use crate::surface::sharpness::from_tag;
+        if tags.is_plain() {
+            self.tags = tags;
+            return Ok(self);
+        }
+        if self.scheme != Scheme::CatmullClark {
+            return Err(Error::InvalidMesh(
+                "subdivision tags (creases, corners, holes) apply to Catmull–Clark cages only"
+                    .into(),
+            ));
+        }
+        let nv = self.vertex_count() as u32;
+        let sharpness_problem = |s: f64| !(s.is_finite() || s == f64::INFINITY) || s < 0.0;
+        let mut edges: BTreeSet<(u32, u32)> = BTreeSet::new();
+        for h in &self.half_edges {
+            let b = self.half_edges[h.next as usize].origin;
+            edges.insert((h.origin.min(b), h.origin.max(b)));
+        }
+        for (&(a, b), s) in tags.creases.iter_mut() {
+            if !edges.contains(&(a, b)) {
+                return Err(Error::InvalidMesh(format!(
+                    "crease {a}–{b}: vertices {a} and {b} are not joined by an edge of the cage"
+                )));
+            }
+            if sharpness_problem(*s) {
+                return Err(Error::InvalidMesh(format!(
+                    "crease {a}–{b}: sharpness {s} is not a number ≥ 0"
+                )));
+            }
+            *s = from_tag(*s);
+        }
+        tags.creases.retain(|_, s| *s > 0.0);
+        for (&v, s) in tags.corners.iter_mut() {
+            if v >= nv {
+                return Err(Error::InvalidMesh(format!(
+                    "corner {v}: the cage has vertices 0 to {}",
+                    nv - 1
+                )));
+            }
+            if sharpness_problem(*s) {
+                return Err(Error::InvalidMesh(format!(
+                    "corner {v}: sharpness {s} is not a number ≥ 0"
+                )));
+            }
+            *s = from_tag(*s);
+        }
+        tags.corners.retain(|_, s| *s > 0.0);
+        let nf = self.faces.len() as u32;
+        if let Some(&f) = tags.holes.iter().find(|&&f| f >= nf) {
+            return Err(Error::InvalidMesh(format!(
+                "hole {f}: the cage has faces 0 to {}",
+                nf - 1
+            )));
+        }
+        if tags.boundary == BoundaryInterpolation::None {
+            // OpenSubdiv's rule: the faces at a boundary vertex carry no surface unless all
+            // its boundary edges are tagged infinitely sharp.
+            for v in 0..nv {
+                let out = self.outgoing(v);
+                let Some(&last) = out.last() else { continue };
+                let first = self.he(out[0]);
+                let incoming = self.he(self.he(last).prev);
+                let open = |a: u32, b: u32| {
+                    tags.creases.get(&(a.min(b), a.max(b))) != Some(&f64::INFINITY)
+                };
+                let exposed = (first.twin.is_none() && open(v, self.he(first.next).origin))
+                    || (incoming.twin.is_none() && open(incoming.origin, v));
+                if exposed {
+                    for h in out {
+                        tags.holes.insert(self.he(h).face);
+                    }
+                }
+            }
+        }
+        if tags.holes.len() == self.faces.len() {
+            return Err(Error::InvalidMesh(
+                "every face is a hole (tagged, or touching the boundary with `interpolateboundary` none): no surface is left".into(),
+            ));
+        }
+        self.tags = tags;
+        Ok(self)
+    }
+
+    /// The subdivision tags (plain for T-splines).
+    pub fn tags(&self) -> &SubdivTags {
+        &self.tags
+    }
+
+    /// Sharpness of the edge `a`–`b` from the tags (0 when smooth or not an edge; boundary
+    /// edges are not included).
+    pub fn edge_sharpness(&self, a: u32, b: u32) -> f64 {
+        self.tags
+            .creases
+            .get(&(a.min(b), a.max(b)))
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    /// True if face `f` carries a piece of the surface: it spans a parameter area and is not
+    /// a hole.
+    pub fn carries_surface(&self, f: u32) -> bool {
+        self.faces[f as usize].is_domain() && !self.tags.holes.contains(&f)
     }
 
     /// Control points, indexed by vertex.

@@ -47,10 +47,14 @@ const LIFT_ROUNDS: usize = 8;
 /// Moves between two checks for cancellation.
 const CANCEL_EVERY: usize = 256;
 
-/// True if the surface may have C0 knot lines (creases): only repeated knots, that is zero
-/// knot intervals, put them in a T-spline; Catmull–Clark limit surfaces are G1 everywhere.
+/// True if the surface may have C0 lines (creases): only repeated knots, that is zero knot
+/// intervals, put them in a T-spline; a Catmull–Clark limit surface is G1 except along
+/// infinitely sharp tagged creases.
 pub fn may_crease(mesh: &TMesh) -> bool {
-    mesh.scheme() == Scheme::TSpline && mesh.half_edges().iter().any(|h| h.knot == 0.0)
+    match mesh.scheme() {
+        Scheme::TSpline => mesh.half_edges().iter().any(|h| h.knot == 0.0),
+        Scheme::CatmullClark => mesh.tags().has_sharp_creases(),
+    }
 }
 
 /// True if a ball of radius `r` placed by its contact normal may cut into the surface

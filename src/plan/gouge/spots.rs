@@ -83,15 +83,18 @@ impl Spots {
                             continue;
                         }
                         let on_side = i == 0 || i == n || j == 0 || j == n;
-                        if !(creases && grid && on_side) {
-                            continue;
-                        }
                         // Face parameters of the sample, and the normal on the other side
                         // of the cell's side: the next cell of the face, or another face.
                         let (u, v) = (
                             rect[0] + (rect[1] - rect[0]) * s,
                             rect[2] + (rect[3] - rect[2]) * t,
                         );
+                        // A subdivision face may crease only along its own sides (tagged
+                        // edges of the cage).
+                        let on_face_side = u == 0.0 || u == 1.0 || v == 0.0 || v == 1.0;
+                        if !(creases && if grid { on_side } else { on_face_side }) {
+                            continue;
+                        }
                         let mut others: Vec<Vector3> = Vec::new();
                         let mut beyond = |k: usize, dir: isize| {
                             let b = if k == 0 { ub } else { vb };
@@ -108,18 +111,21 @@ impl Spots {
                                 true
                             }
                         };
-                        let mut outer = false;
-                        if i == 0 {
-                            outer |= beyond(0, -1);
-                        }
-                        if i == n {
-                            outer |= beyond(0, 1);
-                        }
-                        if j == 0 {
-                            outer |= beyond(1, -1);
-                        }
-                        if j == n {
-                            outer |= beyond(1, 1);
+                        // (A subdivision face's side always borders another face.)
+                        let mut outer = !grid;
+                        if grid {
+                            if i == 0 {
+                                outer |= beyond(0, -1);
+                            }
+                            if i == n {
+                                outer |= beyond(0, 1);
+                            }
+                            if j == 0 {
+                                outer |= beyond(1, -1);
+                            }
+                            if j == n {
+                                outer |= beyond(1, 1);
+                            }
                         }
                         if outer {
                             for o in near.faces_near(&d.point, same) {
