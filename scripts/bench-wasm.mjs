@@ -134,4 +134,64 @@ for (const file of ['simple.tsm', 'mouse.tsm', 'face.tsm', 'fan.tsm', 'Bike.tsm'
   }
   console.log(`${file}: load ${loadMs.toFixed(0)} ms + plan ${planMs.toFixed(0)} ms = ${(loadMs + planMs).toFixed(0)} ms (three-axis, r 1 mm, h 0.05 mm; ${points} CL points, ${status}; target ≤ 2000 ms)`);
 }
+
+// Cages as the page opens them (issue 20): load, summary, and the first draw's tessellation
+// at the page's chordal tolerance (2e-4 of the diagonal). OpenSubdiv's car and rook, and a
+// generated 10 086-face cage (a cube of 41 × 41 quads per side blown onto a sphere of radius
+// 50 mm; 8 extraordinary points); target for the generated one ≤ 1000 ms.
+function cubeSphereObj(n) {
+  const ids = new Map();
+  const vs = [];
+  const vid = (p) => {
+    const key = p.join(',');
+    if (!ids.has(key)) {
+      ids.set(key, vs.length + 1);
+      const q = p.map((c) => c - n / 2);
+      const l = Math.hypot(...q);
+      vs.push(`v ${q.map((c) => (50 * c / l).toFixed(6)).join(' ')}`);
+    }
+    return ids.get(key);
+  };
+  const faces = [];
+  for (const a of [0, 1, 2]) {
+    for (const side of [0, n]) {
+      const [b, c] = [(a + 1) % 3, (a + 2) % 3];
+      const at = (u, v) => { const p = [0, 0, 0]; p[a] = side; p[b] = u; p[c] = v; return vid(p); };
+      for (let u = 0; u < n; u++) {
+        for (let v = 0; v < n; v++) {
+          const quad = [at(u, v), at(u + 1, v), at(u + 1, v + 1), at(u, v + 1)];
+          if (side === 0) quad.reverse();
+          faces.push(`f ${quad.join(' ')}`);
+        }
+      }
+    }
+  }
+  return `${vs.join('\n')}\n${faces.join('\n')}\n`;
+}
+const fixtures = fileURLToPath(new URL('../tests/fixtures/opensubdiv/', import.meta.url));
+for (const [name, bytes, target] of [
+  ['catmark_car.obj', readFileSync(fixtures + 'catmark_car.obj'), ''],
+  ['catmark_rook.obj', readFileSync(fixtures + 'catmark_rook.obj'), ''],
+  ['generated 10 086-face cage', new TextEncoder().encode(cubeSphereObj(41)), '; target ≤ 1000 ms'],
+]) {
+  let loadMs = Infinity;
+  let drawMs = Infinity;
+  let info = '';
+  for (let run = 0; run < 3; run++) {
+    const t0 = performance.now();
+    const m = wasm.Model.fromBytes(bytes, 'cage.obj');
+    const s = m.summary();
+    const t1 = performance.now();
+    const { min, max } = s.bbox_mm;
+    const chordal = Math.max(0.005, Math.hypot(max[0] - min[0], max[1] - min[1], max[2] - min[2]) * 2e-4);
+    const mesh = m.tessellate(chordal);
+    const t2 = performance.now();
+    info = `${s.faces} faces, ${s.extraordinary_points} extraordinary points, ${s.patches} patches, ${mesh.indices().length / 3} triangles`;
+    loadMs = Math.min(loadMs, t1 - t0);
+    drawMs = Math.min(drawMs, t2 - t1);
+    mesh.free();
+    m.free();
+  }
+  console.log(`${name}: load ${loadMs.toFixed(0)} ms + first tessellation ${drawMs.toFixed(0)} ms = ${(loadMs + drawMs).toFixed(0)} ms (${info}${target})`);
+}
 console.log(`wasm memory: ${(wasmMemory().buffer.byteLength / 1048576).toFixed(1)} MB`);

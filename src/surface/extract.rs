@@ -9,7 +9,7 @@
 use super::basis::bspline_bernstein;
 use super::bezier::BezierPatch;
 use super::sharpness::INFINITELY_SHARP;
-use super::subdiv::LocalMesh;
+use super::subdiv::{LocalMap, LocalMesh};
 use super::{FaceForm, FaceSurface};
 use crate::error::{Error, Result};
 use crate::tmesh::{BoundaryInterpolation, Scheme, TMesh, KNOT_MATCH_REL};
@@ -143,7 +143,7 @@ fn check_uniform_region(mesh: &TMesh, ep: u32, region: &HashSet<u32>) -> Result<
 }
 
 /// The faces sharing a vertex with face `f`, as a local quad mesh for subdivision.
-fn local_one_ring(mesh: &TMesh, f: u32) -> Result<(LocalMesh, u32)> {
+pub(super) fn local_one_ring(mesh: &TMesh, f: u32) -> Result<(LocalMesh, u32)> {
     let corners: Vec<u32> = mesh
         .face_half_edges(f)
         .into_iter()
@@ -154,7 +154,7 @@ fn local_one_ring(mesh: &TMesh, f: u32) -> Result<(LocalMesh, u32)> {
     let mut map: HashMap<u32, u32> = HashMap::new();
     let mut pts = Vec::new();
     let mut quads = Vec::with_capacity(faces.len());
-    let mut creases = HashMap::new();
+    let mut creases = LocalMap::default();
     for &g in &faces {
         let hs = mesh.face_half_edges(g);
         if hs.len() != 4 {

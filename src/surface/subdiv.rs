@@ -21,6 +21,42 @@ use super::bezier::{BezierPatch, SurfaceDerivs};
 use super::sharpness::{self, EdgeEnd, VertexRule, INFINITELY_SHARP};
 use crate::geom::{Point3, Vector3, Vector4};
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A hasher for the small integer keys of local meshes (FxHash's rotate-multiply): the maps
+/// are rebuilt at every level, keys are not chosen by an adversary, and SipHash cost a fifth
+/// of building a car-body cage's evaluator.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct LocalHasher(u64);
+
+impl LocalHasher {
+    fn add(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+impl Hasher for LocalHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.add(u64::from(b));
+        }
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.add(u64::from(i));
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.add(i);
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.add(i as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// A hash map keyed by local vertex numbers.
+pub type LocalMap<K, V> = HashMap<K, V, BuildHasherDefault<LocalHasher>>;
 
 /// Depth of subdivision after which the region next to an extraordinary point (2^-depth of
 /// the face's side, about 1e-12) is represented by its limit point.
@@ -41,9 +77,9 @@ pub struct LocalMesh {
     /// Sharpness of the sharp undirected edges `(min, max)`: the model's boundary edges
     /// ([`INFINITELY_SHARP`]) and its creases. An open edge not listed is where the cut
     /// ended.
-    pub creases: HashMap<(u32, u32), f64>,
+    pub creases: LocalMap<(u32, u32), f64>,
     /// Sharpness of the sharp vertices (tagged or interpolated corners).
-    pub corners: HashMap<u32, f64>,
+    pub corners: LocalMap<u32, f64>,
 }
 
 /// The quadtree of a face evaluated by subdivision.
@@ -194,33 +230,70 @@ impl Node {
     }
 }
 
-/// Adjacency of a local mesh, built once per mesh.
+/// Adjacency of a local mesh, built once per mesh: each vertex's outgoing directed edges
+/// (one per quad at the vertex, in quad order), stored contiguously.
 struct Adjacency {
-    /// Directed edge `(a, b)` → (quad, corner index of `a`).
-    directed: HashMap<(u32, u32), (u32, u8)>,
-    /// Quads around each vertex.
-    vertex_quads: Vec<Vec<u32>>,
+    /// Vertex `v`'s edges are entries `start[v]..start[v + 1]`.
+    start: Vec<u32>,
+    /// Far end of each directed edge.
+    to: Vec<u32>,
+    /// Quad holding each directed edge, and the corner index of its start there.
+    quad: Vec<u32>,
+    corner: Vec<u8>,
 }
 
 impl Adjacency {
     fn new(m: &LocalMesh) -> Self {
-        let mut directed = HashMap::with_capacity(m.quads.len() * 4);
-        let mut vertex_quads = vec![Vec::new(); m.pts.len()];
+        let n = m.pts.len();
+        let mut start = vec![0u32; n + 1];
+        for q in &m.quads {
+            for &v in q {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let total = start[n] as usize;
+        let (mut to, mut quad, mut corner) = (vec![0; total], vec![0; total], vec![0; total]);
+        let mut fill = start.clone();
         for (qi, q) in m.quads.iter().enumerate() {
             for k in 0..4 {
-                directed.insert((q[k], q[(k + 1) % 4]), (qi as u32, k as u8));
-                vertex_quads[q[k] as usize].push(qi as u32);
+                let slot = &mut fill[q[k] as usize];
+                let i = *slot as usize;
+                *slot += 1;
+                to[i] = q[(k + 1) % 4];
+                quad[i] = qi as u32;
+                corner[i] = k as u8;
             }
         }
         Adjacency {
-            directed,
-            vertex_quads,
+            start,
+            to,
+            quad,
+            corner,
         }
+    }
+
+    fn range(&self, v: u32) -> std::ops::Range<usize> {
+        self.start[v as usize] as usize..self.start[v as usize + 1] as usize
+    }
+
+    /// Quads at vertex `v`, in quad order.
+    fn quads_at(&self, v: u32) -> &[u32] {
+        &self.quad[self.range(v)]
+    }
+
+    /// The quad holding the directed edge `(a, b)` and the corner index of `a` in it.
+    fn directed(&self, a: u32, b: u32) -> Option<(u32, u8)> {
+        self.range(a)
+            .find(|&i| self.to[i] == b)
+            .map(|i| (self.quad[i], self.corner[i]))
     }
 
     /// True if the undirected edge has a quad on one side only.
     fn is_open(&self, a: u32, b: u32) -> bool {
-        !(self.directed.contains_key(&(a, b)) && self.directed.contains_key(&(b, a)))
+        self.directed(a, b).is_none() || self.directed(b, a).is_none()
     }
 }
 
@@ -254,11 +327,11 @@ impl LocalMesh {
         if self.edge_sharpness(a, b) == INFINITELY_SHARP {
             return None;
         }
-        adj.directed.get(&(a, b)).copied()
+        adj.directed(a, b)
     }
 
     fn around(&self, adj: &Adjacency, v: u32) -> Around {
-        let quads = &adj.vertex_quads[v as usize];
+        let quads = adj.quads_at(v);
         let mut edges: Vec<(u32, f64)> = Vec::with_capacity(quads.len() + 1);
         let mut complete = true;
         for &q in quads {
@@ -297,7 +370,7 @@ impl LocalMesh {
             let qd = &self.quads[quad as usize];
             (qd, qd.iter().position(|&x| x == v).expect("vertex in quad"))
         };
-        let limit = adj.vertex_quads[v as usize].len();
+        let limit = adj.quads_at(v).len();
         let mut count = 1;
         // Counter-clockwise: across each quad's side leaving `v`.
         let mut cur = q;
@@ -356,7 +429,7 @@ impl LocalMesh {
         let adj = Adjacency::new(self);
         let nv = self.pts.len();
         // Edges, numbered in first-seen order.
-        let mut edge_id: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut edge_id: LocalMap<(u32, u32), u32> = LocalMap::default();
         let mut edges: Vec<(u32, u32)> = Vec::new();
         for q in &self.quads {
             for k in 0..4 {
@@ -390,7 +463,7 @@ impl LocalMesh {
             }));
             let smooth = || {
                 let n = a.faces as f64;
-                let quads = &adj.vertex_quads[v as usize];
+                let quads = adj.quads_at(v);
                 let q: Vector4 = quads.iter().map(|&f| face_pts[f as usize]).sum::<Vector4>() / n;
                 let mut r = Vector4::zeros();
                 for &f in quads {
@@ -411,8 +484,8 @@ impl LocalMesh {
         }
         // Edge points.
         for &(a, b) in &edges {
-            let faces = match (adj.directed.get(&(a, b)), adj.directed.get(&(b, a))) {
-                (Some(&(q0, _)), Some(&(q1, _))) => {
+            let faces = match (adj.directed(a, b), adj.directed(b, a)) {
+                (Some((q0, _)), Some((q1, _))) => {
                     Some((face_pts[q0 as usize], face_pts[q1 as usize]))
                 }
                 _ => None,
@@ -436,7 +509,7 @@ impl LocalMesh {
             quads.push([f, e12, c2, e23]);
             quads.push([e30, f, e23, c3]);
         }
-        let mut creases = HashMap::with_capacity(self.creases.len() * 2);
+        let mut creases = LocalMap::default();
         for (&(a, b), &s) in &self.creases {
             let s = sharpness::decayed(s);
             if let (Some(&id), true) = (edge_id.get(&(a, b)), s > 0.0) {
@@ -473,17 +546,20 @@ impl LocalMesh {
     /// The quads sharing a vertex with quad `q`, as a new local mesh; returns it and the
     /// index of `q` in it.
     pub fn one_ring(&self, q: u32) -> (LocalMesh, u32) {
-        let adj = Adjacency::new(self);
+        self.one_ring_with(&Adjacency::new(self), q)
+    }
+
+    fn one_ring_with(&self, adj: &Adjacency, q: u32) -> (LocalMesh, u32) {
         let mut keep: Vec<u32> = Vec::new();
         for &v in &self.quads[q as usize] {
-            for &f in &adj.vertex_quads[v as usize] {
+            for &f in adj.quads_at(v) {
                 if !keep.contains(&f) {
                     keep.push(f);
                 }
             }
         }
         keep.sort_unstable();
-        let mut map: HashMap<u32, u32> = HashMap::new();
+        let mut map: LocalMap<u32, u32> = LocalMap::default();
         let mut pts = Vec::new();
         let mut quads = Vec::with_capacity(keep.len());
         for &f in &keep {
@@ -629,7 +705,7 @@ impl LocalMesh {
             let n = a.faces as f64;
             let mut e = Vector4::zeros();
             let mut f = Vector4::zeros();
-            for &q in &adj.vertex_quads[v as usize] {
+            for &q in adj.quads_at(v) {
                 let quad = &self.quads[q as usize];
                 let k = quad.iter().position(|&x| x == v).unwrap();
                 e += self.pts[quad[(k + 1) % 4] as usize];
@@ -648,10 +724,11 @@ impl LocalMesh {
     /// The quadtree of quad `q`: a Bézier cell if it is regular, else its children after
     /// one subdivision step, recursively.
     pub fn face_tree(&self, q: u32) -> Node {
-        self.tree_at(q, 0)
+        self.tree_at(q, 0, true)
     }
 
-    fn tree_at(&self, q: u32, depth: usize) -> Node {
+    /// `learn`: whether rings that repeat their topology may use a [`LinearStep`].
+    fn tree_at(&self, q: u32, depth: usize, learn: bool) -> Node {
         if let Some(grid) = self.regular_grid(q) {
             return Node::Leaf {
                 patch: bspline_to_bezier(&grid),
@@ -659,29 +736,208 @@ impl LocalMesh {
             };
         }
         let (ring, qi) = self.one_ring(q);
-        // The irregular corner: the one whose vertex is not regular. Measure from its limit
-        // point so the coordinates shrink with the region.
-        let adj = Adjacency::new(&ring);
-        let quad = ring.quads[qi as usize];
-        let corner = quad
-            .iter()
-            .copied()
-            .find(|&c| !ring.regular_corner(&adj, qi, c))
-            .unwrap_or(quad[0]);
-        let limit = ring.limit_point(corner);
+        ring.ring_tree(qi, depth, None, learn)
+    }
+
+    /// True if `other` (with face `other_q`) has the same topology and sharpness as `self`
+    /// (with face `q`): one subdivision step acts on both points alike.
+    fn same_topology(&self, q: u32, other: &LocalMesh, other_q: u32) -> bool {
+        q == other_q
+            && self.pts.len() == other.pts.len()
+            && self.quads == other.quads
+            && self.creases == other.creases
+            && self.corners == other.corners
+    }
+
+    /// The quadtree of face `qi` of `self`, which is that face's one-ring and not regular.
+    /// With `step`, learnt on a ring of this topology, a level costs one sparse product.
+    fn ring_tree(self, qi: u32, depth: usize, step: Option<&LinearStep>, learn: bool) -> Node {
+        // The irregular corner's limit point: the coordinates are measured from it so that
+        // they shrink with the region.
+        let corner = step.is_none().then(|| {
+            let adj = Adjacency::new(&self);
+            let quad = self.quads[qi as usize];
+            quad.iter()
+                .copied()
+                .find(|&c| !self.regular_corner(&adj, qi, c))
+                .unwrap_or(quad[0])
+        });
+        let limit = match (step, corner) {
+            (Some(s), _) => LinearStep::apply(&s.limit, &self.pts),
+            (None, Some(c)) => self.limit_point(c),
+            (None, None) => unreachable!("a corner is found without a step"),
+        };
         if depth >= MAX_DEPTH {
-            let o = ring.origin;
+            let o = self.origin;
             return Node::Cap(
                 limit + Vector4::new(o.x * limit.w, o.y * limit.w, o.z * limit.w, 0.0),
             );
         }
-        let ring = ring.recentred(limit.xyz() / limit.w);
+        let ring = self.recentred(limit.xyz() / limit.w);
+        if let Some(s) = step {
+            return s.tree(ring, qi, depth);
+        }
         let fine = ring.subdivide();
+        let fine_adj = Adjacency::new(&fine);
         let base = 4 * qi;
+        let mut children: Vec<Node> = Vec::with_capacity(4);
+        let mut learnt: Option<LinearStep> = None;
+        for k in 0..4 {
+            if let Some(grid) = fine.regular_grid_with(&fine_adj, base + k) {
+                children.push(Node::Leaf {
+                    patch: bspline_to_bezier(&grid),
+                    origin: fine.origin,
+                });
+                continue;
+            }
+            let (next, nq) = fine.one_ring_with(&fine_adj, base + k);
+            // A ring that comes back unchanged one level down (an extraordinary point in a
+            // smooth or infinitely creased neighbourhood) is subdivided the same way at
+            // every level below: learn that step once.
+            if learn
+                && learnt.is_none()
+                && ring.pts.len() <= LinearStep::MAX_POINTS
+                && ring.same_topology(qi, &next, nq)
+            {
+                learnt = LinearStep::learn(&ring, qi, corner.expect("generic level"));
+            }
+            children.push(next.ring_tree(nq, depth + 1, learnt.as_ref(), learn));
+        }
         // Children are stored [ll, u high, both high, v high]; the tree wants
         // [ll, u high, v high, both high].
-        let c = |k: u32| fine.tree_at(base + k, depth + 1);
-        Node::Split(Box::new([c(0), c(1), c(3), c(2)]))
+        let mut it = children.into_iter();
+        let (c0, c1, c2, c3) = (
+            it.next().expect("4 children"),
+            it.next().expect("4 children"),
+            it.next().expect("4 children"),
+            it.next().expect("4 children"),
+        );
+        Node::Split(Box::new([c0, c1, c3, c2]))
+    }
+}
+
+/// Weights of a ring's points giving one point (sparse: zero weights left out).
+type Row = Vec<(u32, f64)>;
+
+/// One level of an irregular face's quadtree as a linear map of its one-ring's points, for
+/// a ring whose topology comes back unchanged one level down (an extraordinary point in a
+/// smooth or infinitely creased neighbourhood). Learnt once per face by subdividing unit
+/// points through the generic step, then applied at every deeper level instead of building
+/// and subdividing a mesh (OpenSubdiv builds such stencils once, too).
+struct LinearStep {
+    /// The irregular corner's limit point.
+    limit: Row,
+    /// Per child (in [`LocalMesh::subdivide`]'s order): a regular child's 16 Bézier control
+    /// points (`[j][i]` row-major), or `None` for the irregular child.
+    children: [Option<Box<[Row; 16]>>; 4],
+    /// The irregular child's one-ring points.
+    next: Vec<Row>,
+}
+
+impl LinearStep {
+    /// Largest ring (points) a step is learnt for: learning costs a generic level per four
+    /// points, so beyond this (valence about 28) subdividing is cheaper.
+    const MAX_POINTS: usize = 64;
+
+    fn apply(row: &Row, pts: &[Vector4]) -> Vector4 {
+        row.iter().map(|&(i, w)| pts[i as usize] * w).sum()
+    }
+
+    /// The step of ring `ring` (face `qi`, irregular corner `corner`), found by pushing unit
+    /// points through the generic step four at a time (one per homogeneous coordinate);
+    /// `None` unless exactly one child is irregular and its ring has `ring`'s topology.
+    fn learn(ring: &LocalMesh, qi: u32, corner: u32) -> Option<LinearStep> {
+        let n = ring.pts.len();
+        let mut step = LinearStep {
+            limit: Vec::new(),
+            children: [None, None, None, None],
+            next: vec![Vec::new(); n],
+        };
+        let mut leaves: [Option<[Row; 16]>; 4] = Default::default();
+        let mut irregular: Option<u32> = None;
+        let mut probe = ring.clone();
+        probe.origin = Vector3::zeros();
+        for first in (0..n).step_by(4) {
+            for (i, p) in probe.pts.iter_mut().enumerate() {
+                let unit = |c: usize| if i == first + c { 1.0 } else { 0.0 };
+                *p = Vector4::new(unit(0), unit(1), unit(2), unit(3));
+            }
+            // Column `first + c` of every output is its coordinate `c`.
+            let record = |row: &mut Row, v: Vector4| {
+                for c in 0..4 {
+                    if first + c < n && v[c] != 0.0 {
+                        row.push(((first + c) as u32, v[c]));
+                    }
+                }
+            };
+            record(&mut step.limit, probe.limit_point(corner));
+            let fine = probe.subdivide();
+            for k in 0..4u32 {
+                let child = 4 * qi + k;
+                match fine.regular_grid(child) {
+                    Some(grid) => {
+                        let patch = bspline_to_bezier(&grid);
+                        let rows = leaves[k as usize].get_or_insert_with(Default::default);
+                        for (r, p) in rows.iter_mut().zip(patch.cp.iter().flatten()) {
+                            record(r, *p);
+                        }
+                    }
+                    None => {
+                        if irregular.is_some_and(|j| j != k) {
+                            return None;
+                        }
+                        irregular = Some(k);
+                        let (next, nq) = fine.one_ring(child);
+                        if !ring.same_topology(qi, &next, nq) {
+                            return None;
+                        }
+                        for (r, p) in step.next.iter_mut().zip(&next.pts) {
+                            record(r, *p);
+                        }
+                    }
+                }
+            }
+        }
+        irregular?;
+        for (slot, rows) in step.children.iter_mut().zip(leaves) {
+            *slot = rows.map(Box::new);
+        }
+        Some(step)
+    }
+
+    /// The children of `ring` (already measured from its corner's limit point) at `depth`,
+    /// by this step.
+    fn tree(&self, ring: LocalMesh, qi: u32, depth: usize) -> Node {
+        let LocalMesh {
+            pts,
+            origin,
+            quads,
+            creases,
+            corners,
+        } = ring;
+        let mut next = Some(LocalMesh {
+            pts: self.next.iter().map(|r| Self::apply(r, &pts)).collect(),
+            origin,
+            quads,
+            creases,
+            corners,
+        });
+        let mut child = |k: usize| match &self.children[k] {
+            Some(rows) => {
+                let mut patch = BezierPatch::zero();
+                for (c, r) in patch.cp.iter_mut().flatten().zip(rows.iter()) {
+                    *c = Self::apply(r, &pts);
+                }
+                Node::Leaf { patch, origin }
+            }
+            None => {
+                next.take()
+                    .expect("one irregular child")
+                    .ring_tree(qi, depth + 1, Some(self), true)
+            }
+        };
+        let (c0, c1, c2, c3) = (child(0), child(1), child(2), child(3));
+        Node::Split(Box::new([c0, c1, c3, c2]))
     }
 }
 
@@ -707,4 +963,94 @@ pub fn bspline_to_bezier(g: &[[Vector4; 4]; 4]) -> BezierPatch {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::tmesh::TMesh;
+
+    /// A sheet round one interior vertex of valence `n` (its faces, and a ring of faces
+    /// beyond them), with bumpy heights.
+    fn star(n: usize) -> TMesh {
+        let (m, _) = crate::io::obj::read(&star_obj(n)).unwrap();
+        m
+    }
+
+    fn star_obj(n: usize) -> String {
+        // Rings of 2n points at radii 1, 2 and 3 (even: spokes, odd: between), the centre
+        // first.
+        let mut s = String::from("v 0 0 0.3\n");
+        for r in 1..=3 {
+            for k in 0..2 * n {
+                let a = k as f64 * std::f64::consts::PI / n as f64;
+                let rr = r as f64 * if k % 2 == 0 { 1.0 } else { 1.2 };
+                let z = 0.2 * (1.7 * a).sin() * r as f64 - 0.05 * (r * r) as f64;
+                s += &format!("v {} {} {z}\n", rr * a.cos(), rr * a.sin());
+            }
+        }
+        let id = |r: usize, k: usize| 2 + (r - 1) * 2 * n + k % (2 * n);
+        for k in 0..n {
+            let (a, b, c) = (2 * k, 2 * k + 1, 2 * k + 2);
+            s += &format!("f 1 {} {} {}\n", id(1, a), id(1, b), id(1, c));
+            for r in 1..3 {
+                for j in [a, b] {
+                    s += &format!(
+                        "f {} {} {} {}\n",
+                        id(r, j),
+                        id(r + 1, j),
+                        id(r + 1, j + 1),
+                        id(r, j + 1)
+                    );
+                }
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn learnt_steps_give_the_subdivided_tree() {
+        use super::*;
+        // The faces at a valence-5 and a valence-3 point: the tree whose deep levels are one
+        // learnt linear map each equals the tree subdivided level by level, to rounding,
+        // down to the cap (parameters 2^-k from the point).
+        for n in [3, 5, 7] {
+            let mesh = star(n);
+            let size = mesh.control_bbox().diagonal();
+            let mut worst: f64 = 0.0;
+            // Each point's face is followed by four faces of the outer rings.
+            for f in (0..n as u32).map(|k| 5 * k) {
+                let (local, q) = crate::surface::extract::local_one_ring(&mesh, f).unwrap();
+                // One level down the ring repeats its topology and a step is learnt.
+                let (ring, qi) = local.one_ring(q);
+                let down = |m: &LocalMesh, qi: u32| {
+                    let fine = m.subdivide();
+                    let child = (4 * qi..4 * qi + 4)
+                        .find(|&c| fine.regular_grid(c).is_none())
+                        .unwrap();
+                    fine.one_ring(child)
+                };
+                let (r1, q1) = down(&ring, qi);
+                let (r2, q2) = down(&r1, q1);
+                assert!(r1.same_topology(q1, &r2, q2));
+                let adj = Adjacency::new(&r1);
+                let corner = r1.quads[q1 as usize]
+                    .into_iter()
+                    .find(|&c| !r1.regular_corner(&adj, q1, c))
+                    .unwrap();
+                assert!(LinearStep::learn(&r1, q1, corner).is_some());
+                let fast = local.face_tree(q);
+                let slow = local.tree_at(q, 0, false);
+                assert_eq!(fast.leaf_count(), slow.leaf_count());
+                for k in 0..45 {
+                    let t = 0.7f64.powi(k);
+                    for (u, v) in [(t, t), (t, 0.3 * t), (0.01 * t, t), (0.5, t)] {
+                        let (a, b) = (fast.subs(u, v), slow.subs(u, v));
+                        worst = worst.max((a - b).norm() / size);
+                    }
+                }
+            }
+            println!("valence {n}: learnt steps against subdivision {worst:.2e} of the size");
+            assert!(worst < 1e-14, "valence {n}: {worst}");
+        }
+    }
 }
