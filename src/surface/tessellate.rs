@@ -64,42 +64,101 @@ fn segments(c: &dyn Fn(f64) -> (Point3, Vector3, Vector3), tol: f64) -> usize {
 const GRID_ROUNDS: usize = 4;
 
 /// Largest distance, along the normal, between a cell's centre on the surface and the
-/// average of its corners, over the `nu × nv` grid of a face.
-fn grid_deviation(face: &FaceSurface, nu: usize, nv: usize) -> f64 {
-    let p = |i: usize, j: usize| face.subs(i as f64 / nu as f64, j as f64 / nv as f64).coords;
-    let mut rows: Vec<Vec<Vector3>> = (0..=nv)
-        .map(|j| (0..=nu).map(|i| p(i, j)).collect())
+/// average of its corners, over the grid of a face with lines at `us` × `vs`.
+fn grid_deviation(face: &FaceSurface, us: &[f64], vs: &[f64]) -> f64 {
+    let rows: Vec<Vec<Vector3>> = vs
+        .iter()
+        .map(|&v| us.iter().map(|&u| face.subs(u, v).coords).collect())
         .collect();
     let mut worst: f64 = 0.0;
-    for j in 0..nv {
-        for i in 0..nu {
-            let (u, v) = ((i as f64 + 0.5) / nu as f64, (j as f64 + 0.5) / nv as f64);
+    for j in 0..vs.len() - 1 {
+        for i in 0..us.len() - 1 {
+            let (u, v) = (0.5 * (us[i] + us[i + 1]), 0.5 * (vs[j] + vs[j + 1]));
             let c = face.subs(u, v).coords;
             let avg = (rows[j][i] + rows[j][i + 1] + rows[j + 1][i] + rows[j + 1][i + 1]) * 0.25;
             let n = face.normal(u, v).unwrap_or_else(Vector3::z);
             worst = worst.max((c - avg).dot(&n).abs());
         }
     }
-    rows.clear();
     worst
 }
 
-/// Curve along face side at fixed `v` (u from 0 to 1) or fixed `u`.
+/// Spacing of samples along a face's side or an edge, denser towards an end at an
+/// extraordinary point: near one of valence `n` a parameter step `t` spans about `t^α` of
+/// the surface (`α = −log2 λ`, `λ` the subdominant eigenvalue of Catmull–Clark subdivision),
+/// so samples at `t = σ^(1/α)` are about evenly spaced there. `lo` and `hi` are the exponents
+/// at the two ends (1: even).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Grading {
+    lo: f64,
+    hi: f64,
+}
+
+impl Grading {
+    const EVEN: Grading = Grading { lo: 1.0, hi: 1.0 };
+
+    /// Parameter at fraction `σ` of the samples, and its derivative.
+    fn at(&self, sigma: f64) -> (f64, f64) {
+        if *self == Grading::EVEN {
+            return (sigma, 1.0);
+        }
+        if sigma <= 0.5 {
+            let x = 2.0 * sigma;
+            (0.5 * x.powf(self.lo), self.lo * x.powf(self.lo - 1.0))
+        } else {
+            let x = 2.0 * (1.0 - sigma);
+            (1.0 - 0.5 * x.powf(self.hi), self.hi * x.powf(self.hi - 1.0))
+        }
+    }
+
+    /// Lines at `n` graded steps from 0 to 1.
+    fn lines(&self, n: usize) -> Vec<f64> {
+        (0..=n).map(|i| self.at(i as f64 / n as f64).0).collect()
+    }
+}
+
+/// Grading exponent at vertex `v` of `mesh` for faces evaluated by subdivision: `1/α` for
+/// an extraordinary point whose parameter steps shrink on the surface (`α < 1`), else 1. A
+/// boundary vertex counts as the interior one of twice its faces (its mirror image).
+fn grading_exponent(mesh: &TMesh, v: u32) -> f64 {
+    if !mesh.is_extraordinary(v) {
+        return 1.0;
+    }
+    let faces = mesh.outgoing(v).len();
+    let n = if mesh.is_boundary_vertex(v) {
+        2 * faces
+    } else {
+        faces
+    } as f64;
+    let c = (std::f64::consts::TAU / n).cos();
+    let lambda = (5.0 + c + (std::f64::consts::PI / n).cos() * (2.0 * (9.0 + c)).sqrt()) / 16.0;
+    let alpha = -lambda.log2();
+    (1.0 / alpha).clamp(1.0, MAX_GRADING)
+}
+
+/// Largest grading exponent (valence 4 096 and beyond).
+const MAX_GRADING: f64 = 2.0;
+
+/// Curve along face side at fixed `v` (u from 0 to 1) or fixed `u`, with its parameter
+/// graded by `g` (its derivatives scaled to match; the `g''` term is along the tangent and
+/// changes neither the curvature nor the speed that [`segments`] reads).
 fn iso(
     face: &FaceSurface,
     along_u: bool,
     w: f64,
+    g: Grading,
 ) -> impl Fn(f64) -> (Point3, Vector3, Vector3) + '_ {
-    move |t| {
+    move |sigma| {
+        let (t, dt) = g.at(sigma);
         let d = if along_u {
             face.derivs(t, w)
         } else {
             face.derivs(w, t)
         };
         if along_u {
-            (d.point, d.su, d.suu)
+            (d.point, d.su * dt, d.suu * (dt * dt))
         } else {
-            (d.point, d.sv, d.svv)
+            (d.point, d.sv * dt, d.svv * (dt * dt))
         }
     }
 }
@@ -137,26 +196,61 @@ pub fn tessellate(
             rep[a.max(b) as usize] = a.min(b);
         }
     }
+    // Each vertex's grading exponent, and each face's grading across u and v: denser
+    // towards corners at extraordinary points of subdivided faces.
+    let exponent: Vec<f64> = (0..mesh.vertex_count() as u32)
+        .map(|v| grading_exponent(mesh, v))
+        .collect();
+    let grading: Vec<[Grading; 2]> = faces
+        .iter()
+        .map(|face| {
+            if !matches!(face.form, super::FaceForm::Tree(_)) {
+                return [Grading::EVEN; 2];
+            }
+            // Corner at the start of each side: (0,0), (1,0), (1,1), (0,1).
+            let mut corner = [1.0f64; 4];
+            for h in mesh.face_half_edges(face.mesh_face) {
+                let e = mesh.he(h);
+                if e.offset == 0.0 && mesh.sector_quarters(h) == 1 {
+                    corner[e.side as usize % 4] = exponent[e.origin as usize];
+                }
+            }
+            [
+                Grading {
+                    lo: corner[0].max(corner[3]),
+                    hi: corner[1].max(corner[2]),
+                },
+                Grading {
+                    lo: corner[0].max(corner[1]),
+                    hi: corner[3].max(corner[2]),
+                },
+            ]
+        })
+        .collect();
     // Grid cells each face needs across u and v for its own curvature.
     let grid: Vec<(usize, usize)> = faces
         .iter()
-        .map(|face| {
+        .zip(&grading)
+        .map(|(face, &[gu, gv])| {
             let most = |along_u: bool| {
+                let (g, across) = if along_u { (gu, gv) } else { (gv, gu) };
                 ISO_LINES
                     .iter()
-                    .map(|&w| segments(&iso(face, along_u, w), chordal_mm))
+                    .map(|&w| segments(&iso(face, along_u, across.at(w).0, g), chordal_mm))
                     .max()
                     .unwrap_or(1)
             };
             let (mut nu, mut nv) = (most(true), most(false));
-            // A twisted cell bends away from its flat triangles by about |S_uv·n|·Δu·Δv/4.
+            // A twisted cell bends away from its flat triangles by about |S_uv·n|·Δu·Δv/4
+            // (in the graded parameters).
             let mut twist: f64 = 0.0;
             for &a in &ISO_LINES {
                 for &b in &ISO_LINES {
-                    let d = face.derivs(a, b);
+                    let ((u, du), (v, dv)) = (gu.at(a), gv.at(b));
+                    let d = face.derivs(u, v);
                     let n = d.su.cross(&d.sv);
                     if n.norm() > 0.0 {
-                        twist = twist.max(d.suv.dot(&n).abs() / n.norm());
+                        twist = twist.max(d.suv.dot(&n).abs() * du * dv / n.norm());
                     }
                 }
             }
@@ -170,7 +264,7 @@ pub fn tessellate(
             // Measure: the cells' centres against their corners' average, and refine where
             // the estimate fell short (near extraordinary points the parameterisation bends).
             for _ in 0..GRID_ROUNDS {
-                let dev = grid_deviation(face, nu, nv);
+                let dev = grid_deviation(face, &gu.lines(nu), &gv.lines(nv));
                 if dev <= SAFETY * chordal_mm || (nu >= MAX_SEGMENTS && nv >= MAX_SEGMENTS) {
                     break;
                 }
@@ -181,6 +275,22 @@ pub fn tessellate(
             (nu, nv)
         })
         .collect();
+    // An edge is graded towards its ends at extraordinary points, from its start; both faces
+    // beside it sample it alike (the grading seen from the other end is reversed).
+    let tree_face = |f: u32| {
+        domain
+            .get(&f)
+            .is_some_and(|&d| matches!(faces[d].form, super::FaceForm::Tree(_)))
+    };
+    let edge_grading = |h: &crate::tmesh::HalfEdge| {
+        if !tree_face(h.face) {
+            return Grading::EVEN;
+        }
+        Grading {
+            lo: exponent[h.origin as usize],
+            hi: exponent[mesh.he(h.next).origin as usize],
+        }
+    };
     // Segment count per undirected edge: enough for the edge's own curve and for the grids
     // of both faces beside it, so the strips between boundary and grid stay short.
     let mut edge_segments: HashMap<(u32, u32), usize> = HashMap::new();
@@ -200,7 +310,9 @@ pub fn tessellate(
         let len = if h.side % 2 == 0 { f.width } else { f.height };
         let (a, b) = (h.offset / len, (h.offset + h.knot) / len);
         let face = &faces[d];
-        let curve = |t: f64| {
+        let g = edge_grading(h);
+        let curve = |sigma: f64| {
+            let (t, dt) = g.at(sigma);
             let s = a + (b - a) * t;
             let (u, v) = on_side(h.side, s);
             let dd = face.derivs(u, v);
@@ -209,7 +321,9 @@ pub fn tessellate(
             } else {
                 (dd.sv, dd.svv)
             };
-            (dd.point, d1 * (b - a), d2 * ((b - a) * (b - a)))
+            // Sides 2 and 3 run against u and v: the same curve, its speed's sign aside.
+            let step = (b - a) * dt;
+            (dd.point, d1 * step, d2 * (step * step))
         };
         let mut n = segments(&curve, chordal_mm);
         for half in std::iter::once(h).chain(h.twin.map(|t| mesh.he(t))) {
@@ -253,8 +367,9 @@ pub fn tessellate(
                 face.height
             };
             let n = edge_segments[&edge_key(a, b)];
+            let g = edge_grading(e);
             for k in 0..n {
-                let s = (e.offset + e.knot * k as f64 / n as f64) / len;
+                let s = (e.offset + e.knot * g.at(k as f64 / n as f64).0) / len;
                 let (u, v) = on_side(e.side, s);
                 let key = if k == 0 {
                     VKey::Vertex(root(&mut rep, a))
@@ -268,8 +383,8 @@ pub fn tessellate(
         }
         // Inner grid, with lines at the face's patch-piece borders.
         let (nu, nv_) = grid[d];
-        let mut us: Vec<f64> = (0..=nu).map(|i| i as f64 / nu as f64).collect();
-        let mut vs: Vec<f64> = (0..=nv_).map(|j| j as f64 / nv_ as f64).collect();
+        let mut us: Vec<f64> = grading[d][0].lines(nu);
+        let mut vs: Vec<f64> = grading[d][1].lines(nv_);
         for &(_, r) in &pieces[d] {
             us.extend([r[0] / face.width, r[1] / face.width]);
             vs.extend([r[2] / face.height, r[3] / face.height]);
