@@ -479,3 +479,29 @@ fn first_derivatives_alone_equal_the_full_evaluation_bit_for_bit() {
     }
     assert!(trees > 0, "no subdivision face among the samples");
 }
+
+#[test]
+fn grid_evaluation_equals_point_by_point_bit_for_bit() {
+    // Model::smallest_concave_radius and tool_side evaluate whole grids per face at once
+    // (issue 20: the summary of a 10 000-face cage); the numbers must be derivs' own, on
+    // T-spline cells, subdivision leaves (measured from an origin) and deeper trees.
+    let ts = [0.0, 1e-3, 0.2, 0.5, 0.77, 0.999, 1.0];
+    let mut single = 0;
+    for s in SAMPLES {
+        let m = samples::load_sample(s.name).unwrap();
+        for f in m.surface.faces() {
+            single += matches!(
+                f.form,
+                tspath::surface::FaceForm::Tree(tspath::surface::subdiv::Node::Leaf { .. })
+            ) as usize;
+            let mut seen = 0;
+            f.for_each_derivs(&ts, &ts, &mut |u, v, d| {
+                assert_eq!(*d, f.derivs(u, v), "{} at ({u}, {v})", s.name);
+                assert_eq!((u, v), (ts[seen / ts.len()], ts[seen % ts.len()]));
+                seen += 1;
+            });
+            assert_eq!(seen, ts.len() * ts.len());
+        }
+    }
+    assert!(single > 100, "{single} one-leaf faces checked");
+}

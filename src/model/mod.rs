@@ -180,16 +180,13 @@ impl Model {
         *self.side.get_or_init(|| {
             let n = SIDE_SAMPLES;
             let (mut volume, mut up) = (0.0, 0.0);
+            let ts: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect();
             for face in self.surface.faces() {
-                for i in 0..n {
-                    for j in 0..n {
-                        let (u, v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
-                        let d = face.derivs(u, v);
-                        let a = d.su.cross(&d.sv);
-                        volume += d.point.coords.dot(&a);
-                        up += a.z;
-                    }
-                }
+                face.for_each_derivs(&ts, &ts, &mut |_, _, d| {
+                    let a = d.su.cross(&d.sv);
+                    volume += d.point.coords.dot(&a);
+                    up += a.z;
+                });
             }
             let closed = self.mesh.boundary_loops() == 0;
             let s = if closed { volume } else { up };
@@ -214,31 +211,25 @@ impl Model {
             });
             let ts: Vec<f64> = even.chain(crowded).collect();
             let mut best: Option<ConcaveSpot> = None;
+            let flip = self.tool_side() < 0.0;
             for face in self.surface.faces() {
-                for &u in &ts {
-                    for &v in &ts {
-                        let d = face.derivs(u, v);
-                        let Some(g) = crate::surface::DiffGeom::try_from_derivs(&d) else {
-                            continue;
-                        };
-                        let g = if self.tool_side() < 0.0 {
-                            g.flipped()
-                        } else {
-                            g
-                        };
-                        let (_, k_hi) = g.principal();
-                        if !(k_hi > 0.0 && k_hi.is_finite()) {
-                            continue;
-                        }
-                        let radius = 1.0 / k_hi;
-                        if best.is_none_or(|b| radius < b.radius_mm) {
-                            best = Some(ConcaveSpot {
-                                radius_mm: radius,
-                                at_mm: [d.point.x, d.point.y, d.point.z],
-                            });
-                        }
+                face.for_each_derivs(&ts, &ts, &mut |_, _, d| {
+                    let Some(g) = crate::surface::DiffGeom::try_from_derivs(d) else {
+                        return;
+                    };
+                    let g = if flip { g.flipped() } else { g };
+                    let (_, k_hi) = g.principal();
+                    if !(k_hi > 0.0 && k_hi.is_finite()) {
+                        return;
                     }
-                }
+                    let radius = 1.0 / k_hi;
+                    if best.is_none_or(|b| radius < b.radius_mm) {
+                        best = Some(ConcaveSpot {
+                            radius_mm: radius,
+                            at_mm: [d.point.x, d.point.y, d.point.z],
+                        });
+                    }
+                });
             }
             best
         })

@@ -160,9 +160,23 @@ impl BezierPatch {
 
     /// Point with first and second partial derivatives at `(u, v)`.
     pub fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
+        Self::finish_derivs(&self.rows_at(u), v)
+    }
+
+    /// Point and derivatives at `(u, v)` for every `v` of `vs`, passed to `f` with its
+    /// index: the same numbers as [`BezierPatch::derivs`], bit for bit, with the contraction
+    /// along `u` done once.
+    pub fn derivs_along_v(&self, u: f64, vs: &[f64], f: &mut dyn FnMut(usize, SurfaceDerivs)) {
+        let rows = self.rows_at(u);
+        for (k, &v) in vs.iter().enumerate() {
+            f(k, Self::finish_derivs(&rows, v));
+        }
+    }
+
+    /// The rows contracted along `u`: value, d/du and d²/du² of each row `j`.
+    #[inline]
+    fn rows_at(&self, u: f64) -> [[Vector4; 4]; 3] {
         let (bu, dbu, ddbu) = bernstein3(u);
-        let (bv, dbv, ddbv) = bernstein3(v);
-        // Contract along u for each row j: value, d/du, d²/du².
         let mut r0 = [Vector4::zeros(); 4];
         let mut r1 = [Vector4::zeros(); 4];
         let mut r2 = [Vector4::zeros(); 4];
@@ -174,6 +188,13 @@ impl BezierPatch {
                 r2[j] += c * ddbu[i];
             }
         }
+        [r0, r1, r2]
+    }
+
+    #[inline]
+    fn finish_derivs(rows: &[[Vector4; 4]; 3], v: f64) -> SurfaceDerivs {
+        let [r0, r1, r2] = rows;
+        let (bv, dbv, ddbv) = bernstein3(v);
         let mut a = Vector4::zeros();
         let mut au = Vector4::zeros();
         let mut av = Vector4::zeros();
