@@ -5,7 +5,10 @@
 //! taken with the textbook limit masks, and compared with the library's evaluation at the
 //! same dyadic parameters.
 
+mod support;
+
 use std::collections::HashMap;
+use support::{bumpy_sheet, crease_tag};
 use tspath::model::samples;
 use tspath::tmesh::TMesh;
 
@@ -382,41 +385,14 @@ fn non_quad_cage_is_subdivided_once_to_the_same_limit() {
     assert!(b.min[0] > 0.0 && b.max[0] < 2.0 && b.min[2] > 0.0 && b.max[2] < 2.0);
 }
 
-/// A sheet of `n` × `n` quads over [0, n]² with a bumpy height, vertices numbered from 0
-/// row by row (`j * (n + 1) + i`), as OBJ text.
-fn bumpy_sheet(n: usize) -> String {
-    let mut s = String::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64, j as f64);
-            s += &format!(
-                "v {x} {y} {}\n",
-                0.3 * (1.3 * x).sin() * (0.9 * y).cos() + 0.05 * x * y
-            );
-        }
-    }
-    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
-    for j in 0..n {
-        for i in 0..n {
-            s += &format!(
-                "f {} {} {} {}\n",
-                id(i, j),
-                id(i + 1, j),
-                id(i + 1, j + 1),
-                id(i, j + 1)
-            );
-        }
-    }
-    s
-}
-
 #[test]
 fn creased_cube_matches_plain_subdivision() {
     // Issue 20: the top face's loop infinitely sharp (vertices of valence 3 with two sharp
     // edges follow the crease rule), one vertical edge sharp for 2 steps (making two top
     // corners corners for 2 steps), a bottom corner tagged with sharpness 3.
     let obj = format!(
-        "{CUBE_OBJ}t crease 5/1/0 4 5 6 7 4 10\nt crease 2/1/0 1 5 2\nt corner 1/1/0 3 3\n"
+        "{CUBE_OBJ}{}t crease 2/1/0 1 5 2\nt corner 1/1/0 3 3\n",
+        crease_tag(&[4, 5, 6, 7, 4], 10.0)
     );
     let m = obj_model(&obj);
     assert_eq!(m.mesh.tags().creases.len(), 5);
@@ -432,23 +408,17 @@ fn semi_sharp_creases_and_darts_match_plain_subdivision() {
     // an infinitely sharp one ending inside (a dart at vertex 24), and a corner of sharpness 2.
     let n = 6;
     let v = |i: usize, j: usize| j * (n + 1) + i;
-    let chain = |pts: &[(usize, usize)]| {
-        pts.iter()
-            .map(|&(i, j)| v(i, j).to_string())
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
+    let chain =
+        |pts: &[(usize, usize)]| pts.iter().map(|&(i, j)| v(i, j) as u32).collect::<Vec<_>>();
     let across: Vec<(usize, usize)> = (0..=n).map(|i| (i, 2)).collect();
     let crossing: Vec<(usize, usize)> = (0..=n).map(|j| (4, j)).collect();
     let dart = [(1, 5), (2, 5), (3, 5), (3, 4)];
     let obj = format!(
-        "{}t crease {}/1/0 {} 3\nt crease {}/1/0 {} 1\nt crease 4/1/0 {} 10\nt corner 1/1/0 {} 2\n",
+        "{}{}{}{}t corner 1/1/0 {} 2\n",
         bumpy_sheet(n),
-        across.len(),
-        chain(&across),
-        crossing.len(),
-        chain(&crossing),
-        chain(&dart),
+        crease_tag(&chain(&across), 3.0),
+        crease_tag(&chain(&crossing), 1.0),
+        crease_tag(&chain(&dart), 10.0),
         v(1, 1)
     );
     let m = obj_model(&obj);

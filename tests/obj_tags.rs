@@ -6,6 +6,8 @@
 
 mod support;
 
+use support::{bumpy_sheet, crease_tag};
+
 use std::collections::HashMap;
 use tspath::geom::Point3;
 use tspath::io;
@@ -13,34 +15,6 @@ use tspath::model::Model;
 use tspath::plan::{self, PlanOptions, PlanStatus};
 use tspath::surface::on_side;
 use tspath::verify;
-
-/// A sheet of `n` × `n` unit quads with a bumpy height, vertices numbered from 0 row by row
-/// (`j * (n + 1) + i`), faces from 0 row by row (`j * n + i`), as OBJ text.
-fn bumpy_sheet(n: usize) -> String {
-    let mut s = String::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64, j as f64);
-            s += &format!(
-                "v {x} {y} {}\n",
-                0.3 * (1.3 * x).sin() * (0.9 * y).cos() + 0.05 * x * y
-            );
-        }
-    }
-    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
-    for j in 0..n {
-        for i in 0..n {
-            s += &format!(
-                "f {} {} {} {}\n",
-                id(i, j),
-                id(i + 1, j),
-                id(i + 1, j + 1),
-                id(i, j + 1)
-            );
-        }
-    }
-    s
-}
 
 const N: usize = 6;
 
@@ -99,18 +73,9 @@ fn a_closed_loop_of_sharp_creases_is_the_cubic_b_spline_of_its_vertices() {
         (2, 4),
         (2, 3),
     ];
-    let loop_ids: Vec<u32> = ring.iter().map(|&(i, j)| vid(i, j)).collect();
-    let chain: Vec<String> = loop_ids
-        .iter()
-        .chain(std::iter::once(&loop_ids[0]))
-        .map(u32::to_string)
-        .collect();
-    let text = format!(
-        "{}t crease {}/1/0 {} 10\n",
-        bumpy_sheet(N),
-        chain.len(),
-        chain.join(" ")
-    );
+    let mut chain: Vec<u32> = ring.iter().map(|&(i, j)| vid(i, j)).collect();
+    chain.push(chain[0]);
+    let text = format!("{}{}", bumpy_sheet(N), crease_tag(&chain, 10.0));
     let m = load(&text);
     let size = m.surface.bbox().diagonal();
     let loop_ids: Vec<u32> = ring.iter().map(|&(i, j)| mv(&m, i, j)).collect();
@@ -281,7 +246,8 @@ fn malformed_tags_are_refused_naming_their_line() {
         ("t crease 2/1/0 0 1", "announces 3 arguments"),
         ("t crease 2/1/0 0 8 2", "not joined by an edge"),
         ("t crease 2/1/0 0 1 -1", "negative"),
-        ("t crease 3/3/0 0 1 2 1 1 1", "3 sharpness values for 2"),
+        ("t crease 4/3/0 0 1 1 2 1 1 1", "3 sharpness values for 2"),
+        ("t crease 3/1/0 0 1 2 1", "takes vertex pairs"),
         ("t crease 2-1-0 0 1 1", "ints/floats/strings"),
         ("t corner 1/1/0 4000 10", "vertex 4000 is not in the file"),
         ("t hole 1/0/0 36", "face 36 is not in the file"),
@@ -298,8 +264,8 @@ fn malformed_tags_are_refused_naming_their_line() {
             "{tag}: {e}"
         );
     }
-    // Per-edge sharpness along a chain is accepted, and so is a chain of several edges.
-    let ok = format!("{base}t crease 3/2/0 0 1 2 1 3\n");
+    // Several edges in one tag, each with its own sharpness.
+    let ok = format!("{base}t crease 4/2/0 0 1 1 2 1 3\n");
     let m = load(&ok);
     let (a, b, c) = (mv(&m, 0, 0), mv(&m, 1, 0), mv(&m, 2, 0));
     assert_eq!(m.mesh.edge_sharpness(a, b), 1.0);
@@ -310,7 +276,7 @@ fn malformed_tags_are_refused_naming_their_line() {
 #[test]
 fn tags_survive_the_json_format() {
     let text = format!(
-        "{}t crease 3/1/0 7 8 9 10\nt crease 2/1/0 15 16 2.5\nt corner 1/1/0 24 3\nt hole 1/0/0 30\nt interpolateboundary 1/0/0 2\n",
+        "{}t crease 4/1/0 7 8 8 9 10\nt crease 2/1/0 15 16 2.5\nt corner 1/1/0 24 3\nt hole 1/0/0 30\nt interpolateboundary 1/0/0 2\n",
         bumpy_sheet(N)
     );
     let m = load(&text);
@@ -337,8 +303,8 @@ fn a_concave_sharp_crease_plans_without_gouges() {
         .collect();
     let sheet = support::extruded_obj(&profile, 4, 6.0, false);
     // The bottom line: vertex 4 of each profile (9 per row), rows 0..=4.
-    let chain: Vec<String> = (0..=4).map(|k| (k * 9 + 4).to_string()).collect();
-    let text = format!("{sheet}t crease 5/1/0 {} 10\n", chain.join(" "));
+    let chain: Vec<u32> = (0..=4).map(|k| k * 9 + 4).collect();
+    let text = format!("{sheet}{}", crease_tag(&chain, 10.0));
     let m = load(&text);
     assert!(m.layout.patches.len() >= 2, "{}", m.layout.patches.len());
     let opts = PlanOptions::default()

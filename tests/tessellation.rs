@@ -96,43 +96,12 @@ fn tessellations_stay_within_the_chordal_tolerance() {
     }
 }
 
-/// A bowl-shaped sheet round one vertex of valence `n` (radius about 30 mm), as OBJ text:
-/// rings of `2n` points at 10, 20 and 30 mm.
-fn pole_obj(n: usize) -> String {
-    let mut s = String::from("v 0 0 3\n");
-    for r in 1..=3 {
-        for k in 0..2 * n {
-            let a = k as f64 * std::f64::consts::PI / n as f64;
-            let rr = r as f64 * 10.0 * if k % 2 == 0 { 1.0 } else { 1.05 };
-            let z = 3.0 - 0.3 * (r * r) as f64 + 0.5 * (3.0 * a).sin() * r as f64 / 3.0;
-            s += &format!("v {:.6} {:.6} {z:.6}\n", rr * a.cos(), rr * a.sin());
-        }
-    }
-    let id = |r: usize, k: usize| 2 + (r - 1) * 2 * n + k % (2 * n);
-    for k in 0..n {
-        let (a, b, c) = (2 * k, 2 * k + 1, 2 * k + 2);
-        s += &format!("f 1 {} {} {}\n", id(1, a), id(1, b), id(1, c));
-        for r in 1..3 {
-            for j in [a, b] {
-                s += &format!(
-                    "f {} {} {} {}\n",
-                    id(r, j),
-                    id(r + 1, j),
-                    id(r + 1, j + 1),
-                    id(r, j + 1)
-                );
-            }
-        }
-    }
-    s
-}
-
 #[test]
 fn a_high_valence_pole_is_tessellated_by_the_tolerance_not_the_subdivision_depth() {
     // Issue 20: a cage with a valence-64 pole at 1e-3 of its size in fewer than a million
     // triangles (1.29 million before samples were graded towards the pole), within the
     // tolerance and watertight; fewer triangles as the tolerance grows.
-    let m = tspath::io::load(pole_obj(64).as_bytes(), "pole").unwrap();
+    let m = tspath::io::load(samples::pole_cage_obj(64).as_bytes(), "pole").unwrap();
     let size = m.surface.bbox().diagonal();
     let mut last = usize::MAX;
     for rel in [1e-4, 1e-3, 1e-2] {

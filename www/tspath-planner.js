@@ -32,6 +32,8 @@ const REPLAN_DELAY_MS = 300;
 const PREVIEW_SAMPLES = 100000;
 /** G-code lines shown around the current one. */
 const LISTING_LINES = 13;
+/** Patches listed one row each in the patch legend; beyond, one swatch per colour. */
+const PATCH_LEGEND_ROWS = 40;
 /** Values longer than this (characters) go on their own line under their label, per list
  * (the model panel is the narrower). */
 const WIDE_VALUE_CHARS = { summary: 16, stats: 22 };
@@ -945,14 +947,23 @@ export class TspathPlanner extends HTMLElement {
     this.#concaveHint();
     const legend = this.$('patch-legend');
     legend.replaceChildren();
-    if (s.patches <= 40) {
-      for (let i = 0; i < s.patches; i++) {
-        const sw = document.createElement('span');
-        sw.className = 'swatch';
-        sw.style.setProperty('--c', hexCss(PATCH_COLOURS[i % PATCH_COLOURS.length]));
-        sw.textContent = `patch ${i}`;
-        legend.append(sw);
-      }
+    const swatch = (i, text) => {
+      const sw = document.createElement('span');
+      sw.className = 'swatch';
+      sw.style.setProperty('--c', hexCss(PATCH_COLOURS[i % PATCH_COLOURS.length]));
+      sw.textContent = text;
+      legend.append(sw);
+    };
+    if (s.patches <= PATCH_LEGEND_ROWS) {
+      for (let i = 0; i < s.patches; i++) swatch(i, `patch ${i}`);
+    } else {
+      // Many patches (a big cage): one swatch per colour, naming the patches that take it.
+      const n = PATCH_COLOURS.length;
+      const note = document.createElement('span');
+      note.className = 'legend-note';
+      note.textContent = `${s.patches} patches, coloured in turn:`;
+      legend.append(note);
+      for (let i = 0; i < n; i++) swatch(i, `${i}, ${i + n}, ${i + 2 * n}, …`);
     }
   }
 

@@ -6,8 +6,8 @@
 //! other records (`vt`, `vn`, `g`, `o`, `s`, `usemtl`, ...) are skipped. Subdivision tags are
 //! applied as OpenSubdiv reads them, `t name nint/nfloat/nstring args...` with vertices and
 //! faces counted from 0:
-//! - `t crease n/1/0 v0 v1 ... s` (or one sharpness per edge): the chain's edges get
-//!   sharpness `s` (semi-sharp below 10, infinitely sharp from 10);
+//! - `t crease n/1/0 a0 b0 a1 b1 ... s` (or one sharpness per edge): the edges `a–b` of each
+//!   vertex pair get sharpness `s` (semi-sharp below 10, infinitely sharp from 10);
 //! - `t corner n/1/0 v... s`: sharp vertices (interpolated from 10);
 //! - `t interpolateboundary 1/0/0 k`: 0 none (the faces at a boundary vertex carry no surface
 //!   unless all its boundary edges are tagged infinitely sharp),
@@ -278,13 +278,14 @@ fn read_tag(
     };
     match tag {
         "crease" => {
-            if a.ints.len() < 2 {
-                return Err("`t crease` needs a chain of at least two vertices and a sharpness (e.g. `t crease 2/1/0 4 5 2.0`)".into());
+            // Vertex pairs, one edge each (as OpenSubdiv's shape reader takes them).
+            if a.ints.len() < 2 || a.ints.len() % 2 != 0 {
+                return Err(format!("`t crease` takes vertex pairs, one per edge, and a sharpness (e.g. `t crease 4/1/0 4 5 5 6 2.0` for edges 4–5 and 5–6); found {} vertices", a.ints.len()));
             }
-            for k in 0..a.ints.len() - 1 {
-                let (p, q) = (index(a.ints[k], "vertex")?, index(a.ints[k + 1], "vertex")?);
-                tags.creases
-                    .push((p, q, sharpness(k, a.ints.len() - 1)?, line));
+            let edges = a.ints.len() / 2;
+            for (k, pair) in a.ints.chunks(2).enumerate() {
+                let (p, q) = (index(pair[0], "vertex")?, index(pair[1], "vertex")?);
+                tags.creases.push((p, q, sharpness(k, edges)?, line));
             }
         }
         "corner" => {

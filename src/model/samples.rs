@@ -713,3 +713,36 @@ pub fn plane_patch(side: f64) -> Result<TMesh> {
         Scheme::TSpline,
     )
 }
+
+/// OBJ text of a bowl-shaped open cage round one vertex of valence `n` (for tests and
+/// benchmarks of extraordinary points): rings of `2n` points at about 10, 20 and 30 mm,
+/// `n` faces at the pole and `4n` beyond; the far corner of each pole face has 3 faces (so
+/// `n` valence-3 points ring the pole). Heights follow no symmetry of the cage.
+pub fn pole_cage_obj(n: usize) -> String {
+    let mut s = String::from("v 0 0 3\n");
+    for r in 1..=3 {
+        for k in 0..2 * n {
+            let a = k as f64 * std::f64::consts::PI / n as f64;
+            let rr = r as f64 * 10.0 * if k % 2 == 0 { 1.0 } else { 1.05 };
+            let z = 3.0 - 0.3 * (r * r) as f64 + 0.5 * (1.7 * a + 0.3).sin() * r as f64 / 3.0;
+            s += &format!("v {:.6} {:.6} {z:.6}\n", rr * a.cos(), rr * a.sin());
+        }
+    }
+    let id = |r: usize, k: usize| 2 + (r - 1) * 2 * n + k % (2 * n);
+    for k in 0..n {
+        let (a, b, c) = (2 * k, 2 * k + 1, 2 * k + 2);
+        s += &format!("f 1 {} {} {}\n", id(1, a), id(1, b), id(1, c));
+        for r in 1..3 {
+            for j in [a, b] {
+                s += &format!(
+                    "f {} {} {} {}\n",
+                    id(r, j),
+                    id(r + 1, j),
+                    id(r + 1, j + 1),
+                    id(r, j + 1)
+                );
+            }
+        }
+    }
+    s
+}

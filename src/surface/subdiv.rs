@@ -782,6 +782,8 @@ impl LocalMesh {
         let base = 4 * qi;
         let mut children: Vec<Node> = Vec::with_capacity(4);
         let mut learnt: Option<LinearStep> = None;
+        // Once learning failed for this topology it would fail again below: stop trying.
+        let mut learn = learn;
         for k in 0..4 {
             if let Some(grid) = fine.regular_grid_with(&fine_adj, base + k) {
                 children.push(Node::Leaf {
@@ -800,6 +802,7 @@ impl LocalMesh {
                 && ring.same_topology(qi, &next, nq)
             {
                 learnt = LinearStep::learn(&ring, qi, corner.expect("generic level"));
+                learn = learnt.is_some();
             }
             children.push(next.ring_tree(nq, depth + 1, learnt.as_ref(), learn));
         }
@@ -969,42 +972,10 @@ pub fn bspline_to_bezier(g: &[[Vector4; 4]; 4]) -> BezierPatch {
 mod tests {
     use crate::tmesh::TMesh;
 
-    /// A sheet round one interior vertex of valence `n` (its faces, and a ring of faces
-    /// beyond them), with bumpy heights.
+    /// A bowl round one interior vertex of valence `n`.
     fn star(n: usize) -> TMesh {
-        let (m, _) = crate::io::obj::read(&star_obj(n)).unwrap();
+        let (m, _) = crate::io::obj::read(&crate::model::samples::pole_cage_obj(n)).unwrap();
         m
-    }
-
-    fn star_obj(n: usize) -> String {
-        // Rings of 2n points at radii 1, 2 and 3 (even: spokes, odd: between), the centre
-        // first.
-        let mut s = String::from("v 0 0 0.3\n");
-        for r in 1..=3 {
-            for k in 0..2 * n {
-                let a = k as f64 * std::f64::consts::PI / n as f64;
-                let rr = r as f64 * if k % 2 == 0 { 1.0 } else { 1.2 };
-                let z = 0.2 * (1.7 * a).sin() * r as f64 - 0.05 * (r * r) as f64;
-                s += &format!("v {} {} {z}\n", rr * a.cos(), rr * a.sin());
-            }
-        }
-        let id = |r: usize, k: usize| 2 + (r - 1) * 2 * n + k % (2 * n);
-        for k in 0..n {
-            let (a, b, c) = (2 * k, 2 * k + 1, 2 * k + 2);
-            s += &format!("f 1 {} {} {}\n", id(1, a), id(1, b), id(1, c));
-            for r in 1..3 {
-                for j in [a, b] {
-                    s += &format!(
-                        "f {} {} {} {}\n",
-                        id(r, j),
-                        id(r + 1, j),
-                        id(r + 1, j + 1),
-                        id(r, j + 1)
-                    );
-                }
-            }
-        }
-        s
     }
 
     #[test]

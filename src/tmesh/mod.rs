@@ -111,10 +111,13 @@ impl SubdivTags {
         parts.join(", ")
     }
 
-    /// True if some crease is infinitely sharp: the limit surface has a crease (a C0 line)
-    /// along it.
-    pub fn has_sharp_creases(&self) -> bool {
-        self.creases.values().any(|s| s.is_infinite())
+    /// True if some crease or corner is infinitely sharp: the limit surface has a crease (a
+    /// C0 line) or a cone point there.
+    pub fn has_sharp_features(&self) -> bool {
+        self.creases
+            .values()
+            .chain(self.corners.values())
+            .any(|s| s.is_infinite())
     }
 }
 

@@ -1761,8 +1761,9 @@ test('the largest tilt stays within what the machine reaches: 135° on table-tab
 test('an OBJ cage with a sharp crease: the tags are listed, the crease bounds patches, the plan lifts off it; a bad tag is named with its line', async (page, url) => {
   await page.goto(`${url}?model=dome`);
   await waitState(page, 'model-loaded');
-  // Issue 20: the fold line x = 15 mm (vertices 3, 10, 17, 24 counted from 0) infinitely sharp.
-  const obj = `${extrudedObj()}t crease 4/1/0 3 10 17 24 10\n`;
+  // Issue 20: the fold line x = 15 mm (vertices 3, 10, 17, 24 counted from 0) infinitely
+  // sharp: one vertex pair per edge.
+  const obj = `${extrudedObj()}t crease 6/1/0 3 10 10 17 17 24 10\n`;
   await page.setInputFiles('#file', { name: 'creased.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
   await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'creased' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
   const tags = (await page.textContent('#summary-subdivision-tags')).trim();
@@ -1784,6 +1785,26 @@ test('an OBJ cage with a sharp crease: the tags are listed, the crease bounds pa
   check(/badtag\.obj/.test(msg) && msg.includes(`line ${line}`) && /not joined by an edge/.test(msg), `the error names file, line and fault: “${msg}”`);
   check(await attr(page, 'data-model') === 'creased', 'the previous model stays');
   return `“${tags}”, ${patches} patches; “${msg.slice(0, 110)}…”`;
+});
+
+test('a big cage from another tool (OpenSubdiv\'s car body, 1 575 faces with creases): it loads with its first tessellation, and the patch legend names its 552 patches by colour', async (page, url) => {
+  await page.goto(`${url}?model=dome`);
+  await waitState(page, 'model-loaded');
+  const bytes = readFileSync(join(root, 'tests', 'fixtures', 'opensubdiv', 'catmark_car.obj'));
+  const t0 = Date.now();
+  await page.setInputFiles('#file', { name: 'catmark_car.obj', mimeType: 'text/plain', buffer: bytes });
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'catmark_car' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
+  const ms = Date.now() - t0;
+  const patches = Number((await page.textContent('#summary-patches')).trim());
+  const tags = (await page.textContent('#summary-subdivision-tags')).trim();
+  check(patches === 552, `552 patches: ${patches}`);
+  check(/semi-sharp crease edges/.test(tags), `its creases are listed: “${tags}”`);
+  const legend = await page.evaluate((h) => {
+    const el = document.querySelector(h).shadowRoot.getElementById('patch-legend');
+    return { swatches: el.querySelectorAll('.swatch').length, text: el.textContent };
+  }, HOST);
+  check(legend.swatches > 0 && legend.swatches <= 12 && /552 patches/.test(legend.text), `a compact legend: ${legend.swatches} swatches, “${legend.text.slice(0, 80)}”`);
+  return `loaded and tessellated in ${ms} ms; “${tags}”; legend “${legend.text.slice(0, 60)}…”`;
 });
 
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {

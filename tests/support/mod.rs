@@ -260,3 +260,41 @@ pub fn torus_obj(big: f64, small: f64, m: usize, n: usize) -> String {
     }
     s
 }
+
+/// A sheet of `n` × `n` unit quads with a bumpy height, vertices numbered from 0 row by row
+/// (`j * (n + 1) + i`), faces from 0 row by row (`j * n + i`), as OBJ text.
+pub fn bumpy_sheet(n: usize) -> String {
+    let mut s = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64, j as f64);
+            s += &format!(
+                "v {x} {y} {}\n",
+                0.3 * (1.3 * x).sin() * (0.9 * y).cos() + 0.05 * x * y
+            );
+        }
+    }
+    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
+    for j in 0..n {
+        for i in 0..n {
+            s += &format!(
+                "f {} {} {} {}\n",
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j + 1)
+            );
+        }
+    }
+    s
+}
+
+/// A `t crease` tag creasing the edges along the vertex chain `chain` (counted from 0) with
+/// sharpness `s`: one vertex pair per edge, as OBJ cages carry them.
+pub fn crease_tag(chain: &[u32], s: f64) -> String {
+    let pairs: Vec<String> = chain
+        .windows(2)
+        .map(|w| format!("{} {}", w[0], w[1]))
+        .collect();
+    format!("t crease {}/1/0 {} {s}\n", 2 * pairs.len(), pairs.join(" "))
+}

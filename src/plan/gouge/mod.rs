@@ -49,11 +49,11 @@ const CANCEL_EVERY: usize = 256;
 
 /// True if the surface may have C0 lines (creases): only repeated knots, that is zero knot
 /// intervals, put them in a T-spline; a Catmull–Clark limit surface is G1 except along
-/// infinitely sharp tagged creases.
+/// infinitely sharp tagged creases and at infinitely sharp tagged corners.
 pub fn may_crease(mesh: &TMesh) -> bool {
     match mesh.scheme() {
         Scheme::TSpline => mesh.half_edges().iter().any(|h| h.knot == 0.0),
-        Scheme::CatmullClark => mesh.tags().has_sharp_creases(),
+        Scheme::CatmullClark => mesh.tags().has_sharp_features(),
     }
 }
 
