@@ -90,4 +90,27 @@ fn errors_are_actionable() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("scallop_mm"), "{e}");
+    // A 5 mm ball: its default flute (four radii, 20 mm) reaches the default shank's length;
+    // the error says what the default was and which flag to change (found planning a car
+    // body cage in metres).
+    let e = run(&args(&["plan", "dome", "--tool-radius", "5"]))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("four ball radii, 20 mm") && e.contains("--shank-length"),
+        "{e}"
+    );
+    assert!(run(&args(&[
+        "plan",
+        "dome",
+        "--tool-radius",
+        "5",
+        "--scallop",
+        "0.5",
+        "--shank-length",
+        "40",
+        "-o",
+        "/dev/null"
+    ]))
+    .is_ok());
 }

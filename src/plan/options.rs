@@ -349,14 +349,21 @@ impl PlanOptions {
             && self.flute_length() >= 0.0
             && self.flute_length() < self.shank_length_mm)
         {
-            return Err(Error::param(
-                "flute_length_mm",
+            // Unset, the flute is four ball radii: a big ball outgrows the default shank.
+            let why = if self.flute_length_mm.is_none() {
+                format!(
+                    "by default four ball radii, {} mm, it must be shorter than the shank length {} mm: give a longer shank (`--shank-length`, the page's shank length) or a shorter flute",
+                    self.flute_length(),
+                    self.shank_length_mm
+                )
+            } else {
                 format!(
                     "{} mm must be at least 0 and shorter than the shank length {} mm",
                     self.flute_length(),
                     self.shank_length_mm
-                ),
-            ));
+                )
+            };
+            return Err(Error::param("flute_length_mm", why));
         }
         for (name, v) in [("lead_deg", self.lead_deg), ("tilt_deg", self.tilt_deg)] {
             if !(v.is_finite() && v.abs() < 80.0) {
