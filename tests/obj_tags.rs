@@ -8,7 +8,6 @@ mod support;
 
 use support::{bumpy_sheet, crease_tag};
 
-use std::collections::HashMap;
 use tspath::geom::Point3;
 use tspath::io;
 use tspath::model::Model;
@@ -40,20 +39,25 @@ fn load(text: &str) -> Model {
 /// The surface point at fraction `t` along the cage edge from vertex `a` to vertex `b`,
 /// evaluated on the face that runs `a → b`; `None` if that face carries no surface.
 fn along_edge(m: &Model, a: u32, b: u32, t: f64) -> Option<Point3> {
-    let face_index: HashMap<u32, usize> = m
-        .surface
-        .faces()
-        .iter()
-        .enumerate()
-        .map(|(i, f)| (f.mesh_face, i))
-        .collect();
+    let (fi, u, v) = face_param(m, a, b, t)?;
+    Some(m.surface.subs(fi, u, v))
+}
+
+/// Surface face index and `(u, v)` at fraction `t` along the cage edge `a → b` of the face
+/// that runs that way; `None` if there is no such face or it carries no surface.
+fn face_param(m: &Model, a: u32, b: u32, t: f64) -> Option<(usize, f64, f64)> {
     let h = m
         .mesh
         .half_edges()
         .iter()
         .find(|h| h.origin == a && m.mesh.he(h.next).origin == b)?;
+    let fi = m
+        .surface
+        .faces()
+        .iter()
+        .position(|f| f.mesh_face == h.face)?;
     let (u, v) = on_side(h.side, t);
-    Some(m.surface.subs(*face_index.get(&h.face)?, u, v))
+    Some((fi, u, v))
 }
 
 fn cage_point(m: &Model, v: u32) -> Point3 {
@@ -107,7 +111,7 @@ fn a_closed_loop_of_sharp_creases_is_the_cubic_b_spline_of_its_vertices() {
         }
         // And the surface folds there: normals on the two sides differ.
         let normal = |a: u32, b: u32, t: f64| {
-            let (fi, u, v) = face_param(&m, a, b, t);
+            let (fi, u, v) = face_param(&m, a, b, t).unwrap();
             m.surface.faces()[fi].normal(u, v).unwrap()
         };
         kink = kink.max(normal(a, b, 0.5).angle(&normal(b, a, 0.5)).to_degrees());
@@ -134,25 +138,6 @@ fn a_closed_loop_of_sharp_creases_is_the_cubic_b_spline_of_its_vertices() {
     }
     assert_eq!(load(&bumpy_sheet(N)).layout.patches.len(), 1);
     println!("patches with the crease: {}", m.layout.patches.len());
-}
-
-/// Surface face index and `(u, v)` at fraction `t` along the edge `a → b` of the face that
-/// runs that way.
-fn face_param(m: &Model, a: u32, b: u32, t: f64) -> (usize, f64, f64) {
-    let h = m
-        .mesh
-        .half_edges()
-        .iter()
-        .find(|h| h.origin == a && m.mesh.he(h.next).origin == b)
-        .unwrap();
-    let fi = m
-        .surface
-        .faces()
-        .iter()
-        .position(|f| f.mesh_face == h.face)
-        .unwrap();
-    let (u, v) = on_side(h.side, t);
-    (fi, u, v)
 }
 
 #[test]

@@ -325,11 +325,12 @@ impl FileTags {
     /// naming the tag's line.
     fn resolve(&self, faces: &[Vec<u32>], nv: usize) -> Result<SubdivTags> {
         let at = |line: usize| format!("line {line}");
-        let mut edges: HashSet<(u32, u32)> = HashSet::new();
+        // Faces at each undirected edge (the cage's edges; one face: its boundary).
+        let mut edge_count: HashMap<(u32, u32), usize> = HashMap::new();
         for f in faces {
             for k in 0..f.len() {
                 let (a, b) = (f[k], f[(k + 1) % f.len()]);
-                edges.insert((a.min(b), a.max(b)));
+                *edge_count.entry((a.min(b), a.max(b))).or_default() += 1;
             }
         }
         let vertex = |v: u32, line: usize| -> Result<()> {
@@ -348,7 +349,7 @@ impl FileTags {
             vertex(a, line)?;
             vertex(b, line)?;
             let key = (a.min(b), a.max(b));
-            if !edges.contains(&key) {
+            if !edge_count.contains_key(&key) {
                 return Err(Error::parse(
                     FORMAT,
                     at(line),
@@ -378,17 +379,9 @@ impl FileTags {
             out.boundary = mode;
         }
         if out.boundary == BoundaryInterpolation::None {
-            // Faces touching the boundary carry no surface: find them on the cage, before
-            // any polygon is split.
-            let mut edge_count: HashMap<(u32, u32), usize> = HashMap::new();
-            for f in faces {
-                for k in 0..f.len() {
-                    let (a, b) = (f[k], f[(k + 1) % f.len()]);
-                    *edge_count.entry((a.min(b), a.max(b))).or_default() += 1;
-                }
-            }
-            // OpenSubdiv's rule: the faces at a boundary vertex carry no surface unless all
-            // its boundary edges are tagged infinitely sharp.
+            // OpenSubdiv's rule, on the cage before any polygon is split: the faces at a
+            // boundary vertex carry no surface unless all its boundary edges are tagged
+            // infinitely sharp.
             let on_boundary: HashSet<u32> = edge_count
                 .iter()
                 .filter(|(e, &n)| n == 1 && out.creases.get(e) != Some(&INFINITELY_SHARP))
@@ -653,21 +646,8 @@ pub fn subdivide_polygons(
             quads.push(vec![v, ev(v, next), c, ev(prev, v)]);
         }
     }
-    let mut creases = std::collections::BTreeMap::new();
-    for (&(a, b), &s) in &tags.creases {
-        let s = sharpness::decayed(s);
-        if s > 0.0 {
-            let e = ev(a, b);
-            creases.insert((a.min(e), a.max(e)), s);
-            creases.insert((b.min(e), b.max(e)), s);
-        }
-    }
-    let corners = tags
-        .corners
-        .iter()
-        .map(|(&v, &s)| (v, sharpness::decayed(s)))
-        .filter(|&(_, s)| s > 0.0)
-        .collect();
+    let creases = sharpness::child_creases(&tags.creases, |a, b| Some(ev(a, b))).collect();
+    let corners = sharpness::child_corners(&tags.corners).collect();
     let fine = SubdivTags {
         creases,
         corners,

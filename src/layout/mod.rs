@@ -233,8 +233,8 @@ impl PatchLayout {
         let mut cut_edges: HashSet<u32> = HashSet::new();
         let mut face_cuts: Vec<(Vec<f64>, Vec<f64>)> =
             vec![(Vec::new(), Vec::new()); surface.faces().len()];
-        for (hi, _) in mesh.half_edges().iter().enumerate() {
-            if creased[mesh.half_edges()[hi].origin as usize] && crease(hi as u32) {
+        for (hi, h) in mesh.half_edges().iter().enumerate() {
+            if creased[h.origin as usize] && crease(hi as u32) {
                 cut_edges.insert(hi as u32);
             }
         }

@@ -38,6 +38,33 @@ pub fn decayed(s: f64) -> f64 {
     }
 }
 
+/// The creases one step down: each sharp edge `(a, b)` still sharp after [`decayed`] gives
+/// its two halves `(a, m)` and `(m, b)` (undirected, `(min, max)`), `m` its edge point from
+/// `mid`; an edge `mid` does not know (no face of the mesh has it) is dropped. Vertices keep
+/// their numbers.
+pub fn child_creases<'a>(
+    creases: impl IntoIterator<Item = (&'a (u32, u32), &'a f64)> + 'a,
+    mid: impl Fn(u32, u32) -> Option<u32> + 'a,
+) -> impl Iterator<Item = ((u32, u32), f64)> + 'a {
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    creases
+        .into_iter()
+        .map(|(&(a, b), &s)| (a, b, decayed(s)))
+        .filter(|&(_, _, s)| s > 0.0)
+        .filter_map(move |(a, b, s)| Some((a, b, s, mid(a, b)?)))
+        .flat_map(move |(a, b, s, m)| [(key(a, m), s), (key(m, b), s)])
+}
+
+/// The sharp vertices one step down ([`decayed`], the smooth ones dropped).
+pub fn child_corners<'a>(
+    corners: impl IntoIterator<Item = (&'a u32, &'a f64)> + 'a,
+) -> impl Iterator<Item = (u32, f64)> + 'a {
+    corners
+        .into_iter()
+        .map(|(&v, &s)| (v, decayed(s)))
+        .filter(|&(_, s)| s > 0.0)
+}
+
 /// The rule a vertex follows, from its own sharpness and its edges'.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VertexRule {

@@ -372,31 +372,26 @@ impl LocalMesh {
         };
         let limit = adj.quads_at(v).len();
         let mut count = 1;
-        // Counter-clockwise: across each quad's side leaving `v`.
-        let mut cur = q;
-        while count < limit {
-            let (qd, k) = pos(cur);
-            let w = qd[(k + 1) % 4];
-            match self.across(adj, w, v) {
-                Some((n, _)) if n != q => {
-                    cur = n;
-                    count += 1;
+        // Counter-clockwise across each quad's side leaving `v` (corner k + 1), then
+        // clockwise across the side arriving (corner k + 3), each until an edge blocks; a
+        // full turn round `v` ends both.
+        for leaving in [true, false] {
+            let mut cur = q;
+            while count < limit {
+                let (qd, k) = pos(cur);
+                let next = if leaving {
+                    self.across(adj, qd[(k + 1) % 4], v)
+                } else {
+                    self.across(adj, v, qd[(k + 3) % 4])
+                };
+                match next {
+                    Some((n, _)) if n != q => {
+                        cur = n;
+                        count += 1;
+                    }
+                    Some(_) => return count,
+                    None => break,
                 }
-                Some(_) => return count,
-                None => break,
-            }
-        }
-        // Clockwise: across each quad's side arriving at `v`.
-        let mut cur = q;
-        while count < limit {
-            let (qd, k) = pos(cur);
-            let w = qd[(k + 3) % 4];
-            match self.across(adj, v, w) {
-                Some((n, _)) if n != q => {
-                    cur = n;
-                    count += 1;
-                }
-                _ => break,
             }
         }
         count
@@ -509,21 +504,12 @@ impl LocalMesh {
             quads.push([f, e12, c2, e23]);
             quads.push([e30, f, e23, c3]);
         }
-        let mut creases = LocalMap::default();
-        for (&(a, b), &s) in &self.creases {
-            let s = sharpness::decayed(s);
-            if let (Some(&id), true) = (edge_id.get(&(a, b)), s > 0.0) {
-                let e = nv as u32 + id;
-                creases.insert(edge_key(a, e), s);
-                creases.insert(edge_key(e, b), s);
-            }
-        }
-        let corners = self
-            .corners
-            .iter()
-            .map(|(&v, &s)| (v, sharpness::decayed(s)))
-            .filter(|&(_, s)| s > 0.0)
-            .collect();
+        // (A crease between two kept vertices whose quads were cut away has no edge point.)
+        let creases = sharpness::child_creases(&self.creases, |a, b| {
+            edge_id.get(&edge_key(a, b)).map(|&id| nv as u32 + id)
+        })
+        .collect();
+        let corners = sharpness::child_corners(&self.corners).collect();
         LocalMesh {
             pts,
             origin: self.origin,
@@ -695,9 +681,12 @@ impl LocalMesh {
     /// semi-sharp vertex or edge is taken as sharp (callers ask only once it is one or the
     /// other, or for a nearby point).
     pub fn limit_point(&self, v: u32) -> Vector4 {
-        let adj = Adjacency::new(self);
+        self.limit_point_with(&Adjacency::new(self), v)
+    }
+
+    fn limit_point_with(&self, adj: &Adjacency, v: u32) -> Vector4 {
         let p = self.pts[v as usize];
-        let a = self.around(&adj, v);
+        let a = self.around(adj, v);
         if !a.complete {
             return p;
         }
@@ -729,13 +718,14 @@ impl LocalMesh {
 
     /// `learn`: whether rings that repeat their topology may use a [`LinearStep`].
     fn tree_at(&self, q: u32, depth: usize, learn: bool) -> Node {
-        if let Some(grid) = self.regular_grid(q) {
+        let adj = Adjacency::new(self);
+        if let Some(grid) = self.regular_grid_with(&adj, q) {
             return Node::Leaf {
                 patch: bspline_to_bezier(&grid),
                 origin: self.origin,
             };
         }
-        let (ring, qi) = self.one_ring(q);
+        let (ring, qi) = self.one_ring_with(&adj, q);
         ring.ring_tree(qi, depth, None, learn)
     }
 
@@ -754,18 +744,18 @@ impl LocalMesh {
     fn ring_tree(self, qi: u32, depth: usize, step: Option<&LinearStep>, learn: bool) -> Node {
         // The irregular corner's limit point: the coordinates are measured from it so that
         // they shrink with the region.
-        let corner = step.is_none().then(|| {
-            let adj = Adjacency::new(&self);
-            let quad = self.quads[qi as usize];
-            quad.iter()
-                .copied()
-                .find(|&c| !self.regular_corner(&adj, qi, c))
-                .unwrap_or(quad[0])
-        });
-        let limit = match (step, corner) {
-            (Some(s), _) => LinearStep::apply(&s.limit, &self.pts),
-            (None, Some(c)) => self.limit_point(c),
-            (None, None) => unreachable!("a corner is found without a step"),
+        let (limit, corner) = match step {
+            Some(s) => (LinearStep::apply(&s.limit, &self.pts), None),
+            None => {
+                let adj = Adjacency::new(&self);
+                let quad = self.quads[qi as usize];
+                let c = quad
+                    .iter()
+                    .copied()
+                    .find(|&c| !self.regular_corner(&adj, qi, c))
+                    .unwrap_or(quad[0]);
+                (self.limit_point_with(&adj, c), Some(c))
+            }
         };
         if depth >= MAX_DEPTH {
             let o = self.origin;
