@@ -207,12 +207,15 @@ fn valence_five_gives_corner_connections() {
 }
 
 #[test]
-fn patches_of_a_component_laid_out_cell_by_cell_connect_along_their_sides() {
-    // Issue 13: Bike.tsm and face.tsm are laid out one patch per cell (their faces do not
-    // form one rectangle), and the sides between those cells were recorded as corner
-    // connections only, so the patch order saw no shared side. Every boundary connection must
-    // be a stretch of side the two patches really share.
-    for (file, least) in [("Bike.tsm", 100), ("face.tsm", 200)] {
+fn a_model_in_one_chart_that_is_no_rectangle_is_cut_only_at_its_concave_corners() {
+    // Issue 20: Bike.tsm and face.tsm lie in one chart whose outline is not a rectangle (a
+    // slot in Bike's, two holes in face's), and were laid out one patch per cell: 81 and 135
+    // patches, a checkerboard of passes. Now the chart is cut only by the lines its concave
+    // corners need: 5 and 13 patches, covering the surface once (their area equals the
+    // faces'), meeting side to side and corner to corner (every boundary connection a whole
+    // side of both patches, so the patch order can pass at a shared corner), and (issue 13)
+    // every boundary connection a stretch of side the two patches really share.
+    for (file, before, now) in [("Bike.tsm", 81, 5), ("face.tsm", 135, 13)] {
         let path = format!("{}/www/models/grapetec/{file}", env!("CARGO_MANIFEST_DIR"));
         let m = tspath::io::load(&std::fs::read(&path).unwrap(), file).unwrap();
         let tol = 1e-7 * m.surface.bbox().diagonal();
@@ -237,6 +240,49 @@ fn patches_of_a_component_laid_out_cell_by_cell_connect_along_their_sides() {
                 })
                 .count()
         };
+        let patches = m.layout.patches.len();
+        println!("{file}: {patches} patches (were {before})");
+        assert_eq!(patches, now, "{file}");
+        assert!(3 * patches <= before, "{file}: {patches} patches");
+        // Area by the midpoint rule on each face and on each patch: two parametrisations of
+        // the same surface.
+        let n = 96;
+        let mid = |k: usize| (k as f64 + 0.5) / n as f64;
+        let faces: f64 = m
+            .surface
+            .faces()
+            .iter()
+            .map(|f| {
+                let mut a = 0.0;
+                for i in 0..n {
+                    for j in 0..n {
+                        let d = f.derivs(mid(i), mid(j));
+                        a += d.su.cross(&d.sv).norm();
+                    }
+                }
+                a / (n * n) as f64
+            })
+            .sum();
+        let laid: f64 = m
+            .layout
+            .patches
+            .iter()
+            .map(|p| {
+                let mut a = 0.0;
+                for i in 0..n {
+                    for j in 0..n {
+                        let d = p.derivs(&m.surface, mid(i), mid(j));
+                        a += d.su.cross(&d.sv).norm();
+                    }
+                }
+                a / (n * n) as f64
+            })
+            .sum();
+        println!("{file}: area {laid:.3} mm² by patch, {faces:.3} mm² by face");
+        assert!(
+            (laid - faces).abs() <= 2e-3 * faces,
+            "{file}: {laid} against {faces}"
+        );
         let boundary: Vec<_> = m
             .layout
             .connections
@@ -244,14 +290,47 @@ fn patches_of_a_component_laid_out_cell_by_cell_connect_along_their_sides() {
             .filter(|c| c.kind == ConnectionKind::Boundary)
             .collect();
         println!("{file}: {} boundary connections", boundary.len());
-        assert!(boundary.len() >= least, "{file}: {}", boundary.len());
+        assert!(boundary.len() >= patches - 1, "{file}: {}", boundary.len());
         for c in boundary {
             let (sa, sb) = c.sides.unwrap();
             let pa = &m.layout.patches[c.a as usize];
             let pb = &m.layout.patches[c.b as usize];
-            let shared = on(&side(pa, sa, 32), &side(pb, sb, 2048))
-                + on(&side(pb, sb, 32), &side(pa, sa, 2048));
-            assert!(shared >= 4, "{file}: patches {} and {}: {shared}", c.a, c.b);
+            // Whole sides: all 33 points of each side lie on the other's.
+            let shared = (
+                on(&side(pa, sa, 32), &side(pb, sb, 2048)),
+                on(&side(pb, sb, 32), &side(pa, sa, 2048)),
+            );
+            assert_eq!(shared, (33, 33), "{file}: patches {} and {}", c.a, c.b);
+        }
+    }
+}
+
+#[test]
+fn a_rectangle_reaching_a_patch_side_reaches_its_faces_sides() {
+    // Issue 20: face.tsm cut at its holes' corners put a piece a few ulps wide of a face
+    // into the neighbouring patch, and the rest area of a footprint reaching the patch's
+    // side ended 6e-16 short of the face's: the simulation's samples on that side fell
+    // outside the rest area (0.01004 mm left there against h 0.01 mm, r 0.5 mm). Every
+    // patch's whole rectangle, taken back to its faces, covers each face exactly once, its
+    // sides exactly at 0 or 1 where they reach the face's.
+    for file in ["Bike.tsm", "face.tsm", "mouse.tsm"] {
+        let path = format!("{}/www/models/grapetec/{file}", env!("CARGO_MANIFEST_DIR"));
+        let m = tspath::io::load(&std::fs::read(&path).unwrap(), file).unwrap();
+        let mut covered = vec![0.0; m.surface.faces().len()];
+        for p in &m.layout.patches {
+            for (face, r) in p.face_rects(&m.surface, [0.0, 1.0, 0.0, 1.0]) {
+                assert!(r[1] > r[0] && r[3] > r[2], "{file}: face {face}: {r:?}");
+                for x in r {
+                    assert!(
+                        x == 0.0 || x == 1.0 || (1e-9..=1.0 - 1e-9).contains(&x),
+                        "{file}: face {face}: {r:?}"
+                    );
+                }
+                covered[face as usize] += (r[1] - r[0]) * (r[3] - r[2]);
+            }
+        }
+        for (face, a) in covered.iter().enumerate() {
+            assert!((a - 1.0).abs() < 1e-12, "{file}: face {face} covered {a}");
         }
     }
 }

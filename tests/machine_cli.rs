@@ -107,15 +107,17 @@ fn machine_and_dialect_errors_are_actionable() {
 
 #[test]
 fn rapids_turn_the_rotaries_only_at_the_top_of_z() {
-    // face.tsm with a fat short shank needs tilted axes and three retractions between
-    // patches whose axes differ. A rapid that turned the rotaries while traversing would
-    // swing the table (and the part) under the tool: they turn at the top of Z first.
+    // gearbox2-9.tsm with a fat short shank needs tilted axes and retractions between cuts
+    // whose axes differ (the rest area it leaves out). A rapid that turned the rotaries
+    // while traversing would swing the table (and the part) under the tool: they turn at the
+    // top of Z first. (face.tsm served until its layout stopped forcing retractions, issue
+    // 20.)
     let dir = std::env::temp_dir().join(format!("tspath-rapids-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("face.nc").to_str().unwrap().to_string();
+    let out = dir.join("gearbox.nc").to_str().unwrap().to_string();
     run(&args(&[
         "plan",
-        "www/models/grapetec/face.tsm",
+        "www/models/grapetec/gearbox2-9.tsm",
         "--tool-radius",
         "1",
         "--scallop",
@@ -166,15 +168,17 @@ fn rapids_turn_the_rotaries_only_at_the_top_of_z() {
         }
         rot = (a, c);
     }
-    println!("face.tsm, table-table-ac: the rotaries turn {turned_at_top} times at the top of Z");
+    println!(
+        "gearbox2-9.tsm, table-table-ac: the rotaries turn {turned_at_top} times at the top of Z"
+    );
     assert!(
         turned_at_top >= 2,
-        "the retractions between patches turn the rotaries"
+        "the retractions between cuts turn the rotaries"
     );
     // The program reads back and simulates.
     let report = run(&args(&[
         "verify",
-        "www/models/grapetec/face.tsm",
+        "www/models/grapetec/gearbox2-9.tsm",
         &out,
         "--tool-radius",
         "1",

@@ -111,6 +111,39 @@ fn keycaps_at_the_papers_settings_need_no_retraction() {
 }
 
 #[test]
+fn face_and_bike_plan_without_a_forced_retraction() {
+    // Issue 20: at the page's defaults face.tsm was laid out in 135 patches and forced into
+    // retractions (2 on main before the cut at concave corners; 3 when the issue was filed),
+    // Bike.tsm in 81 and forced into 1. Their 13 and 5 patches now meet corner to corner and
+    // the patch order links them all on the surface.
+    for file in ["face.tsm", "Bike.tsm"] {
+        let path = format!("{}/www/models/grapetec/{file}", env!("CARGO_MANIFEST_DIR"));
+        let m = tspath::io::load(&std::fs::read(&path).unwrap(), file).unwrap();
+        let opts = PlanOptions::default();
+        let planned = isoparametric::plan(&m, &opts, &mut |_| true).unwrap();
+        let report = planned.report(&opts);
+        println!(
+            "{file}: {} patches, {} retractions, {} reversals, cutting {:.0} mm, {:.2} min",
+            report.patches,
+            report.retractions,
+            report.reversals,
+            report.cutting_length_mm,
+            report.machining_time_min
+        );
+        assert_eq!(planned.forced_retractions, 0, "{file}");
+        assert_eq!(report.retractions, 0, "{file}");
+        assert!(
+            !report
+                .notes
+                .iter()
+                .any(|n| n.contains("retraction(s) used")),
+            "{file}: {:?}",
+            report.notes
+        );
+    }
+}
+
+#[test]
 fn t_junction_sample_needs_no_retraction_and_the_three_axis_head_leaves_its_underside() {
     // The closed head planned three-axis: its underside cannot be reached from above. The
     // plan leaves it out, says so as a problem with the area and why, and the path cuts

@@ -12,7 +12,7 @@ use support::{
 use tspath::geom::{Point3, Vector3};
 use tspath::machine::{self, Dialect, JobInfo, Units};
 use tspath::model::samples;
-use tspath::plan::{isoparametric, PlanOptions, PlanStatus, Planned};
+use tspath::plan::{isoparametric, reach, PlanOptions, PlanStatus, Planned};
 use tspath::verify::{self, gcode::read_tool_poses};
 use tspath::Model;
 
@@ -367,8 +367,12 @@ fn the_public_tsm_files_at_the_page_defaults_keep_their_scallop_and_prove_it() {
 /// page defaults reported 24.64 mm², then 0.80 mm² (9 × 9 samples, a strip along a crease
 /// counted as wide as a sample's share), where the simulation finds 0.20 mm² uncut. The
 /// plan is simulated again without its rest area masked, at 8 M samples, and the two must
-/// agree within the simulation's own uncertainty (the area of the cells on the uncut area's
-/// edge, or one sample's share) and within a factor 1.5 where it is more than 0.01 mm².
+/// agree within the two measurements' own uncertainties — the simulation's (the area of the
+/// cells on the uncut area's edge, or one sample's share) and the rest's (a footprint left
+/// too tight counts at least one finest cell, [`reach::LEAST_SHARE`] of it, so that a peak
+/// only the search found is not reported as nothing: Bike.tsm r 1 mm h 0.05 mm reports
+/// 0.00012 mm² from such footprints where 8 M samples find none, one sample's share being
+/// 0.00011 mm²) — and within a factor 1.5 where it is more than 0.01 mm².
 fn rest_matches_the_uncut_area(
     file: &str,
     m: &Model,
@@ -387,13 +391,40 @@ fn rest_matches_the_uncut_area(
     // (an area smaller than that may lie between samples).
     let edge = v.uncut_edge_fraction * v.area_mm2 + v.area_mm2 / v.samples as f64;
     let rest = report.unreachable_area_mm2;
-    println!("{file}: rest {rest:.4} mm², simulated uncut {uncut:.4} ± {edge:.4} mm²");
+    // The least share counted of each footprint left too tight (its area by the midpoint
+    // rule on 4 × 4 points).
+    let layout = planned.layout.as_ref().unwrap_or(&m.layout);
+    let floor: f64 = planned
+        .rest
+        .footprints
+        .iter()
+        .filter(|(_, why)| *why == reach::Why::TooTight)
+        .map(|(f, _)| {
+            let patch = &layout.patches[f.patch as usize];
+            let [u0, u1, v0, v1] = f.rect;
+            let n = 4;
+            let mut area = 0.0;
+            for i in 0..n {
+                for j in 0..n {
+                    let u = u0 + (u1 - u0) * (i as f64 + 0.5) / n as f64;
+                    let v = v0 + (v1 - v0) * (j as f64 + 0.5) / n as f64;
+                    let d = patch.derivs(&m.surface, u, v);
+                    area += d.su.cross(&d.sv).norm();
+                }
+            }
+            reach::LEAST_SHARE * area * (u1 - u0) * (v1 - v0) / (n * n) as f64
+        })
+        .sum::<f64>()
+        .max(0.0);
+    println!(
+        "{file}: rest {rest:.4} mm² (at least {floor:.5} mm² counted), simulated uncut {uncut:.4} ± {edge:.4} mm²"
+    );
     if uncut > 0.0 {
         assert!(rest > 0.0, "{file}: {uncut} mm² uncut, none reported");
     }
     assert!(
-        (rest - uncut).abs() <= edge,
-        "{file}: rest {rest} mm², simulated uncut {uncut} ± {edge} mm²"
+        (rest - uncut).abs() <= edge + floor,
+        "{file}: rest {rest} mm², simulated uncut {uncut} ± {edge} mm², rest's least share {floor} mm²"
     );
     if uncut > 0.01 {
         assert!(

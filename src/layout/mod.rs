@@ -11,6 +11,8 @@
 //! Owns: tracing, cells, patch charts and connections, and patch evaluation. Must not:
 //! change the mesh or the surface.
 
+pub mod cuts;
+
 use crate::geom::Point3;
 use crate::surface::{Surface, SurfaceDerivs};
 use crate::tmesh::walk::{rot, unit, LineStep};
@@ -382,10 +384,23 @@ impl PatchLayout {
                 adjacency[b].push((a, hb, ha));
             }
         }
+        let placed: Vec<Option<Vec<(usize, Placement)>>> = comps
+            .iter()
+            .map(|comp| place_cells(mesh, &cells, comp, &adjacency))
+            .collect();
+        // One component in one chart that is not a rectangle (face.tsm: two holes; Bike.tsm:
+        // a slot in the outline): cut at its concave corners, not a patch per cell.
+        if let [Some(whole)] = placed.as_slice() {
+            if as_rectangle(&cells, whole.clone()).is_none() {
+                if let Some(layout) = chart_layout(surface, &cells, whole) {
+                    return layout;
+                }
+            }
+        }
         let mut patches: Vec<Patch> = Vec::new();
         let mut patch_of_cell = vec![0u32; n];
-        for comp in &comps {
-            let placed = place_component(mesh, &cells, comp, &adjacency);
+        for (comp, placed) in comps.iter().zip(placed) {
+            let placed = placed.and_then(|p| as_rectangle(&cells, p));
             let chunks: Vec<Vec<(usize, Placement)>> = match placed {
                 Some(p) => vec![p],
                 // Not a rectangle (e.g. a band closing on itself): one patch per cell.
@@ -577,8 +592,8 @@ impl PatchLayout {
 }
 
 /// Places the cells of a component in one chart by walking across shared edges. `None` if
-/// the placement is inconsistent or the cells do not fill a rectangle.
-fn place_component(
+/// the placement is inconsistent.
+fn place_cells(
     mesh: &TMesh,
     cells: &Cells,
     comp: &[usize],
@@ -627,26 +642,78 @@ fn place_component(
     if placed.len() != comp.len() {
         return None;
     }
+    Some(comp.iter().map(|&c| (c, placed[&c])).collect())
+}
+
+/// The placements of `place_cells` moved so that the cells' bounding box starts at the
+/// chart's origin, if the cells fill that box (a rectangle).
+fn as_rectangle(
+    cells: &Cells,
+    mut placed: Vec<(usize, Placement)>,
+) -> Option<Vec<(usize, Placement)>> {
     // Rectangle check: the cells' areas add up to their bounding box.
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     let mut area = 0.0;
-    for &c in comp {
-        let (a, b) = chart_rect(&cells.cells[c].rect, placed[&c]);
+    for &(c, pl) in &placed {
+        let (a, b) = chart_rect(&cells.cells[c].rect, pl);
         lo = [lo[0].min(a[0]), lo[1].min(a[1])];
         hi = [hi[0].max(b[0]), hi[1].max(b[1])];
         area += (b[0] - a[0]) * (b[1] - a[1]);
     }
     let box_area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
-    if !(box_area > 0.0) || (area - box_area).abs() > 1e-9 * box_area {
+    if !(box_area > 0.0) || (area - box_area).abs() > RECT_FILL_REL * box_area {
         return None;
     }
-    let mut out: Vec<(usize, Placement)> = comp.iter().map(|&c| (c, placed[&c])).collect();
-    for (_, pl) in out.iter_mut() {
+    for (_, pl) in placed.iter_mut() {
         pl.1 = [pl.1[0] - lo[0], pl.1[1] - lo[1]];
     }
-    Some(out)
+    Some(placed)
 }
+
+/// The layout of a model whose cells (all of them, `placed` in one chart) do not fill a
+/// rectangle (a notch in the outline, a hole without the lines that would cut round it):
+/// the chart cut at its concave corners ([`cuts::cut_at_concave_corners`]), each region one
+/// patch. `None` if a region is not a rectangle.
+fn chart_layout(
+    surface: &Surface,
+    cells: &Cells,
+    placed: &[(usize, Placement)],
+) -> Option<PatchLayout> {
+    let mut placements = vec![
+        crate::tmesh::walk::Placement {
+            face: 0,
+            quarter_turns: 0,
+            offset: [0.0, 0.0],
+        };
+        surface
+            .faces()
+            .iter()
+            .map(|f| f.mesh_face as usize + 1)
+            .max()?
+    ];
+    let mut chart = Vec::with_capacity(placed.len());
+    for &(c, (k, offset)) in placed {
+        let mesh_face = surface.faces()[cells.cells[c].face as usize].mesh_face;
+        placements[mesh_face as usize] = crate::tmesh::walk::Placement {
+            face: mesh_face,
+            quarter_turns: k,
+            offset,
+        };
+        let (a, b) = chart_rect(&cells.cells[c].rect, (k, offset));
+        chart.push([a[0], b[0], a[1], b[1]]);
+    }
+    let size = chart
+        .iter()
+        .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
+        .fold(0.0f64, f64::max);
+    let rects = cuts::cut_at_concave_corners(&chart, KNOT_MATCH_REL * size.max(1.0))?;
+    PatchLayout::from_chart_rects(surface, &placements, &rects)
+}
+
+/// Face parameters (dimensionless) this close to a face's side are on it: the round trip
+/// through a chart (offset, quarter turns) moves them by a few ulps.
+const FACE_SIDE_SNAP: f64 = 1e-12;
 
 /// Relative mismatch between a chart rectangle's area and the face parts inside it above
 /// which faces do not fill it.
@@ -701,6 +768,7 @@ impl Patch {
         }
         let mut pieces = Vec::new();
         let mut area = 0.0;
+        let tol = KNOT_MATCH_REL * width.max(height).max(1.0);
         for (fi, f) in surface.faces().iter().enumerate() {
             let pl = placements.get(f.mesh_face as usize)?;
             let (k, off) = (pl.quarter_turns % 4, pl.offset);
@@ -709,19 +777,30 @@ impl Patch {
                 [a[0].max(rect[0]), a[1].max(rect[2])],
                 [b[0].min(rect[1]), b[1].min(rect[3])],
             );
-            if !(hi[0] > lo[0] && hi[1] > lo[1]) {
+            // A face whose side lies on the rectangle's side only to rounding would leave a
+            // piece a few ulps wide (and its neighbour a few ulps short of its side).
+            if !(hi[0] - lo[0] > tol && hi[1] - lo[1] > tol) {
                 continue;
             }
             area += (hi[0] - lo[0]) * (hi[1] - lo[1]);
             let back = |c: [f64; 2]| rot((4 - k) % 4, [c[0] - off[0], c[1] - off[1]]);
             let (x, y) = (back(lo), back(hi));
+            let snap = |v: f64, size: f64| {
+                if v.abs() <= tol {
+                    0.0
+                } else if (v - size).abs() <= tol {
+                    size
+                } else {
+                    v.clamp(0.0, size)
+                }
+            };
             pieces.push(Piece {
                 face: fi as u32,
                 local: [
-                    x[0].min(y[0]).max(0.0),
-                    x[0].max(y[0]).min(f.width),
-                    x[1].min(y[1]).max(0.0),
-                    x[1].max(y[1]).min(f.height),
+                    snap(x[0].min(y[0]), f.width),
+                    snap(x[0].max(y[0]), f.width),
+                    snap(x[1].min(y[1]), f.height),
+                    snap(x[1].max(y[1]), f.height),
                 ],
                 quarter_turns: k,
                 offset: [off[0] - rect[0], off[1] - rect[2]],
@@ -873,7 +952,19 @@ impl Patch {
             };
             let (x, y) = (back(clo), back(chi));
             let face = &surface.faces()[p.face as usize];
-            let unit = |v: f64, size: f64| (v / size).clamp(0.0, 1.0);
+            // A footprint reaching the piece's side reaches the face's side: the round trip
+            // through the chart must not leave it a few ulps short (a sample on the side would
+            // fall outside the rest area).
+            let unit = |v: f64, size: f64| {
+                let t = (v / size).clamp(0.0, 1.0);
+                if t <= FACE_SIDE_SNAP {
+                    0.0
+                } else if t >= 1.0 - FACE_SIDE_SNAP {
+                    1.0
+                } else {
+                    t
+                }
+            };
             out.push((
                 p.face,
                 [

@@ -1,0 +1,198 @@
+//! A domain laid flat in one chart that does not fill a rectangle (a notch in its outline, a
+//! hole) cut into rectangles where its concave corners need it: at each concave corner the
+//! two boundary sides meeting there are carried on into the domain until they reach its
+//! boundary again. Between those lines every region is a rectangle, and a line ends only on
+//! the boundary, so neighbouring regions meet side to side and corner to corner: the patch
+//! order can always pass from a patch to the next at a corner they share. Knot lines and
+//! T-junctions elsewhere cut nothing.
+//!
+//! Owns: the cut, in chart coordinates. Must not: evaluate the surface or read the mesh.
+
+/// The rectangles `[s0, s1, t0, t1]` (knot units) the domain made of `faces` (chart
+/// rectangles, not overlapping) falls into when cut at its concave corners, in the order of
+/// their lower-left corners (by `t`, then `s`). `tol` is the distance (knot units) within
+/// which two face sides lie on one line. `None` if a region is not a rectangle (faces
+/// overlapping, which a consistent chart never has).
+pub fn cut_at_concave_corners(faces: &[[f64; 4]], tol: f64) -> Option<Vec<[f64; 4]>> {
+    let mut lines = [Vec::new(), Vec::new()];
+    for r in faces {
+        lines[0].extend([r[0], r[1]]);
+        lines[1].extend([r[2], r[3]]);
+    }
+    for l in lines.iter_mut() {
+        l.sort_by(f64::total_cmp);
+        l.dedup_by(|a, b| (*a - *b).abs() <= tol);
+    }
+    let [s, t] = &lines;
+    let (ns, nt) = (s.len().checked_sub(1)?, t.len().checked_sub(1)?);
+    // Cells of the grid of all face sides, inside the domain or not.
+    let mut inside = vec![false; ns * nt];
+    for j in 0..nt {
+        for i in 0..ns {
+            let c = [0.5 * (s[i] + s[i + 1]), 0.5 * (t[j] + t[j + 1])];
+            inside[j * ns + i] = faces
+                .iter()
+                .any(|r| c[0] >= r[0] && c[0] <= r[1] && c[1] >= r[2] && c[1] <= r[3]);
+        }
+    }
+    let is_in = |i: isize, j: isize| {
+        i >= 0
+            && j >= 0
+            && (i as usize) < ns
+            && (j as usize) < nt
+            && inside[j as usize * ns + i as usize]
+    };
+    // Cut cell sides: `vcut[j * (ns + 1) + a]` on line `s[a]` in row `j`, `hcut[b * ns + i]`
+    // on line `t[b]` in column `i`.
+    let mut vcut = vec![false; nt * (ns + 1)];
+    let mut hcut = vec![false; (nt + 1) * ns];
+    for b in 1..nt as isize {
+        for a in 1..ns as isize {
+            // The four cells round grid point (a, b); a concave corner has one outside.
+            let quads = [(a - 1, b - 1), (a, b - 1), (a - 1, b), (a, b)];
+            let outside: Vec<(isize, isize)> =
+                quads.into_iter().filter(|&(i, j)| !is_in(i, j)).collect();
+            let [(oi, oj)] = outside[..] else { continue };
+            // The boundary side along t[b] runs on the outside cell's side of the corner;
+            // carried on, it goes the other way, between the rows b − 1 and b.
+            let step_i: isize = if oi < a { 1 } else { -1 };
+            let mut i = if oi < a { a } else { a - 1 };
+            while is_in(i, b - 1) && is_in(i, b) {
+                hcut[b as usize * ns + i as usize] = true;
+                i += step_i;
+            }
+            let step_j: isize = if oj < b { 1 } else { -1 };
+            let mut j = if oj < b { b } else { b - 1 };
+            while is_in(a - 1, j) && is_in(a, j) {
+                vcut[j as usize * (ns + 1) + a as usize] = true;
+                j += step_j;
+            }
+        }
+    }
+    // Regions: inside cells joined across uncut sides, found in row-major order.
+    let mut region = vec![usize::MAX; ns * nt];
+    let mut out = Vec::new();
+    for start in 0..ns * nt {
+        if !inside[start] || region[start] != usize::MAX {
+            continue;
+        }
+        let id = out.len();
+        region[start] = id;
+        let mut stack = vec![start];
+        let (mut lo, mut hi) = ([ns, nt], [0, 0]);
+        let mut count = 0;
+        while let Some(c) = stack.pop() {
+            let (i, j) = (c % ns, c / ns);
+            count += 1;
+            lo = [lo[0].min(i), lo[1].min(j)];
+            hi = [hi[0].max(i + 1), hi[1].max(j + 1)];
+            let mut next = |ok: bool, n: usize| {
+                if ok && inside[n] && region[n] == usize::MAX {
+                    region[n] = id;
+                    stack.push(n);
+                }
+            };
+            next(i > 0 && !vcut[j * (ns + 1) + i], c.wrapping_sub(1));
+            next(i + 1 < ns && !vcut[j * (ns + 1) + i + 1], c + 1);
+            next(j > 0 && !hcut[j * ns + i], c.wrapping_sub(ns));
+            next(j + 1 < nt && !hcut[(j + 1) * ns + i], c + ns);
+        }
+        if count != (hi[0] - lo[0]) * (hi[1] - lo[1]) {
+            return None;
+        }
+        out.push([s[lo[0]], s[hi[0]], t[lo[1]], t[hi[1]]]);
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit squares at the given integer positions.
+    fn squares(at: &[(i32, i32)]) -> Vec<[f64; 4]> {
+        at.iter()
+            .map(|&(i, j)| [i as f64, i as f64 + 1.0, j as f64, j as f64 + 1.0])
+            .collect()
+    }
+
+    fn grid_without(n: i32, holes: &[(i32, i32)]) -> Vec<[f64; 4]> {
+        let at: Vec<(i32, i32)> = (0..n)
+            .flat_map(|j| (0..n).map(move |i| (i, j)))
+            .filter(|p| !holes.contains(p))
+            .collect();
+        squares(&at)
+    }
+
+    #[test]
+    fn an_l_shape_is_cut_once_at_its_concave_corner() {
+        // 2 × 2 less the top-right square: the corner (1, 1) carries both sides on, the
+        // regions are the three squares.
+        let r = cut_at_concave_corners(&grid_without(2, &[(1, 1)]), 1e-9).unwrap();
+        assert_eq!(r, squares(&[(0, 0), (1, 0), (0, 1)]));
+    }
+
+    #[test]
+    fn a_hole_cuts_the_lines_through_its_sides_and_nothing_else() {
+        // 5 × 5 with a hole at (2, 2): the lines s = 2, 3 and t = 2, 3 run across; the knot
+        // lines s = 1, 4 and t = 1, 4 cut nothing: 3 × 3 regions less the hole.
+        let r = cut_at_concave_corners(&grid_without(5, &[(2, 2)]), 1e-9).unwrap();
+        let spans = [(0.0, 2.0), (2.0, 3.0), (3.0, 5.0)];
+        let mut want = Vec::new();
+        for (k, &(t0, t1)) in spans.iter().enumerate() {
+            for (l, &(s0, s1)) in spans.iter().enumerate() {
+                if (k, l) != (1, 1) {
+                    want.push([s0, s1, t0, t1]);
+                }
+            }
+        }
+        assert_eq!(r, want);
+    }
+
+    #[test]
+    fn lines_stop_at_the_boundary_they_reach() {
+        // A notch from the top, (2, 3) and (2, 4) out of 5 × 5: its two bottom corners carry
+        // t = 3 outwards and s = 2, 3 down; above t = 3 nothing crosses s = 1 or s = 4.
+        let r = cut_at_concave_corners(&grid_without(5, &[(2, 3), (2, 4)]), 1e-9).unwrap();
+        assert_eq!(
+            r,
+            vec![
+                [0.0, 2.0, 0.0, 3.0],
+                [2.0, 3.0, 0.0, 3.0],
+                [3.0, 5.0, 0.0, 3.0],
+                [0.0, 2.0, 3.0, 5.0],
+                [3.0, 5.0, 3.0, 5.0],
+            ]
+        );
+        // The regions cover the faces once, and every corner of a region inside the domain
+        // is a corner of each region it touches (no T-junction between regions).
+        let area: f64 = r.iter().map(|q| (q[1] - q[0]) * (q[3] - q[2])).sum();
+        assert_eq!(area, 23.0);
+    }
+
+    #[test]
+    fn regions_meet_corner_to_corner() {
+        // Two holes in one column and a notch: no region's corner lies inside another
+        // region's side.
+        let faces = grid_without(7, &[(3, 1), (3, 4), (0, 6), (1, 6)]);
+        let r = cut_at_concave_corners(&faces, 1e-9).unwrap();
+        for a in &r {
+            for corner in [[a[0], a[2]], [a[1], a[2]], [a[0], a[3]], [a[1], a[3]]] {
+                for b in &r {
+                    let on_s = (corner[0] == b[0] || corner[0] == b[1])
+                        && corner[1] > b[2]
+                        && corner[1] < b[3];
+                    let on_t = (corner[1] == b[2] || corner[1] == b[3])
+                        && corner[0] > b[0]
+                        && corner[0] < b[1];
+                    assert!(
+                        !on_s && !on_t,
+                        "{a:?}'s corner {corner:?} inside {b:?}'s side"
+                    );
+                }
+            }
+        }
+        let area: f64 = r.iter().map(|q| (q[1] - q[0]) * (q[3] - q[2])).sum();
+        assert_eq!(area, faces.len() as f64);
+    }
+}
