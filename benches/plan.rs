@@ -2,6 +2,11 @@
 //! chordal 0.001 mm, tool axis with collision checks): the patch-by-patch zig-zag's passes,
 //! the space-filling curve's (issue 14; target 150 ms for the convex keycap), and the whole
 //! plan of each (the shared pipeline included). `cargo bench --bench plan`.
+//!
+//! `cargo bench --bench plan -- scaling`: how the whole plan grows with the area (bumps at
+//! 1, 2 and 4 times its size: 16 times the area) and with the patches (face.tsm in 13
+//! patches, Bike.tsm in 5, at the page's defaults); each prints its area, patches and CL
+//! points so that time per CL point and per mm² can be read off (issue 20).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -96,5 +101,59 @@ fn bench_plan(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_plan);
+fn bench_scaling(c: &mut Criterion) {
+    let mut group = c.benchmark_group("scaling");
+    group.sample_size(10);
+    // Area by the midpoint rule, 32 × 32 points per face.
+    let area = |m: &tspath::Model| -> f64 {
+        let n = 32;
+        let mid = |k: usize| (k as f64 + 0.5) / n as f64;
+        m.surface
+            .faces()
+            .iter()
+            .map(|f| {
+                let mut a = 0.0;
+                for i in 0..n {
+                    for j in 0..n {
+                        let d = f.derivs(mid(i), mid(j));
+                        a += d.su.cross(&d.sv).norm();
+                    }
+                }
+                a / (n * n) as f64
+            })
+            .sum()
+    };
+    let say = |label: &str, m: &tspath::Model, o: &PlanOptions| {
+        let n = whole_plan(m, o);
+        println!(
+            "{label}: {:.0} mm², {} patches, {n} moves",
+            area(m),
+            m.layout.len()
+        );
+    };
+    let o = PlanOptions::default()
+        .with_tool_radius(1.0)
+        .with_scallop(0.05);
+    for scale in [1.0, 2.0, 4.0] {
+        let setup = tspath::model::setup::ImportSetup {
+            scale,
+            ..Default::default()
+        };
+        let m = samples::load_sample_with("bumps", &setup).unwrap();
+        let label = format!("bumps x{scale} whole plan");
+        say(&label, &m, &o);
+        group.bench_function(label, |b| b.iter(|| black_box(whole_plan(&m, &o))));
+    }
+    let o = PlanOptions::default();
+    for file in ["face.tsm", "Bike.tsm"] {
+        let path = format!("{}/www/models/grapetec/{file}", env!("CARGO_MANIFEST_DIR"));
+        let m = tspath::io::load(&std::fs::read(&path).unwrap(), file).unwrap();
+        let label = format!("{file} whole plan");
+        say(&label, &m, &o);
+        group.bench_function(label, |b| b.iter(|| black_box(whole_plan(&m, &o))));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_plan, bench_scaling);
 criterion_main!(benches);
