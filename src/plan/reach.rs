@@ -613,6 +613,7 @@ pub fn shares_left(
         side: model.tool_side(),
         unreached_mm: f64::INFINITY,
     };
+    let near_mm = probe.probe.near_mm();
     Ok(footprints
         .iter()
         .map(|(f, why)| {
@@ -624,6 +625,16 @@ pub fn shares_left(
             } else {
                 LEFT_OUT_GRID
             };
+            // The samples' first looks lie round the footprint: the capsules near it listed
+            // once (as the search for its peak does).
+            let patch = &model.layout.patches[f.patch as usize];
+            let [u0, u1, v0, v1] = f.rect;
+            let c = patch.subs(&model.surface, 0.5 * (u0 + u1), 0.5 * (v0 + v1));
+            let far = [(u0, v0), (u1, v0), (u0, v1), (u1, v1)]
+                .iter()
+                .map(|&(u, v)| (patch.subs(&model.surface, u, v) - c).norm())
+                .fold(0.0, f64::max);
+            probe.probe.focus(&c, FOCUS_GROWTH * far + near_mm);
             let corners: Vec<Corner> = probe
                 .grid(f, grid.samples)
                 .into_iter()
