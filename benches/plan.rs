@@ -5,8 +5,8 @@
 //!
 //! `cargo bench --bench plan -- scaling`: how the whole plan grows with the area (bumps at
 //! 1, 2 and 4 times its size: 16 times the area) and with the patches (face.tsm in 13
-//! patches, Bike.tsm in 5, at the page's defaults); each prints its area, patches and CL
-//! points so that time per CL point and per mm² can be read off (issue 20).
+//! patches, Bike.tsm in 5, at the page's defaults); each prints its area, patches and moves
+//! (air moves included) so that time per move and per mm² can be read off (issue 20).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;

@@ -1,19 +1,25 @@
 //! A domain laid flat in one chart that does not fill a rectangle (a notch in its outline, a
 //! hole) cut into rectangles where its concave corners need it: at each concave corner the
 //! two boundary sides meeting there are carried on into the domain until they reach its
-//! boundary again. Between those lines every region is a rectangle, and a line ends only on
-//! the boundary, so neighbouring regions meet side to side and corner to corner: the patch
-//! order can always pass from a patch to the next at a corner they share. Knot lines and
-//! T-junctions elsewhere cut nothing.
+//! boundary again. Sides between faces the mesh does not join (a crease's zero-width strip)
+//! are boundary too: they are cut, and carried on past their ends the same way. Between
+//! those lines every region is a rectangle, and a line ends only on the boundary, so
+//! neighbouring regions meet side to side and corner to corner: the patch order can always
+//! pass from a patch to the next at a corner they share. Knot lines and T-junctions
+//! elsewhere cut nothing.
 //!
 //! Owns: the cut, in chart coordinates. Must not: evaluate the surface or read the mesh.
 
 /// The rectangles `[s0, s1, t0, t1]` (knot units) the domain made of `faces` (chart
-/// rectangles, not overlapping) falls into when cut at its concave corners, in the order of
-/// their lower-left corners (by `t`, then `s`). `tol` is the distance (knot units) within
-/// which two face sides lie on one line. `None` if a region is not a rectangle (faces
-/// overlapping, which a consistent chart never has).
-pub fn cut_at_concave_corners(faces: &[[f64; 4]], tol: f64) -> Option<Vec<[f64; 4]>> {
+/// rectangles, not overlapping) falls into when cut at its concave corners and along the
+/// sides between faces `i` and `j` for which `joined(i, j)` is false, in the order of their
+/// lower-left corners (by `t`, then `s`). `tol` is the distance (knot units) within which
+/// two face sides lie on one line. `None` if a region is not a rectangle.
+pub fn cut_at_concave_corners(
+    faces: &[[f64; 4]],
+    joined: &dyn Fn(usize, usize) -> bool,
+    tol: f64,
+) -> Option<Vec<[f64; 4]>> {
     let mut lines = [Vec::new(), Vec::new()];
     for r in faces {
         lines[0].extend([r[0], r[1]]);
@@ -25,47 +31,95 @@ pub fn cut_at_concave_corners(faces: &[[f64; 4]], tol: f64) -> Option<Vec<[f64; 
     }
     let [s, t] = &lines;
     let (ns, nt) = (s.len().checked_sub(1)?, t.len().checked_sub(1)?);
-    // Cells of the grid of all face sides, inside the domain or not.
-    let mut inside = vec![false; ns * nt];
+    // The face holding each cell of the grid of all face sides, if any.
+    let mut face_of = vec![None; ns * nt];
     for j in 0..nt {
         for i in 0..ns {
             let c = [0.5 * (s[i] + s[i + 1]), 0.5 * (t[j] + t[j + 1])];
-            inside[j * ns + i] = faces
+            face_of[j * ns + i] = faces
                 .iter()
-                .any(|r| c[0] >= r[0] && c[0] <= r[1] && c[1] >= r[2] && c[1] <= r[3]);
+                .position(|r| c[0] >= r[0] && c[0] <= r[1] && c[1] >= r[2] && c[1] <= r[3]);
         }
     }
-    let is_in = |i: isize, j: isize| {
-        i >= 0
-            && j >= 0
-            && (i as usize) < ns
-            && (j as usize) < nt
-            && inside[j as usize * ns + i as usize]
+    let at = |i: isize, j: isize| -> Option<usize> {
+        if i >= 0 && j >= 0 && (i as usize) < ns && (j as usize) < nt {
+            face_of[j as usize * ns + i as usize]
+        } else {
+            None
+        }
     };
     // Cut cell sides: `vcut[j * (ns + 1) + a]` on line `s[a]` in row `j`, `hcut[b * ns + i]`
-    // on line `t[b]` in column `i`.
+    // on line `t[b]` in column `i`. A side is open when both its cells are inside and their
+    // faces are one or joined; a side between faces not joined is cut from the start.
+    let open = |x: (isize, isize), y: (isize, isize)| match (at(x.0, x.1), at(y.0, y.1)) {
+        (Some(f), Some(g)) => f == g || joined(f, g),
+        _ => false,
+    };
+    let inside_pair =
+        |x: (isize, isize), y: (isize, isize)| at(x.0, x.1).is_some() && at(y.0, y.1).is_some();
     let mut vcut = vec![false; nt * (ns + 1)];
     let mut hcut = vec![false; (nt + 1) * ns];
-    for b in 1..nt as isize {
+    for j in 0..nt as isize {
         for a in 1..ns as isize {
-            // The four cells round grid point (a, b); a concave corner has one outside.
-            let quads = [(a - 1, b - 1), (a, b - 1), (a - 1, b), (a, b)];
-            let outside: Vec<(isize, isize)> =
-                quads.into_iter().filter(|&(i, j)| !is_in(i, j)).collect();
-            let [(oi, oj)] = outside[..] else { continue };
-            // The boundary side along t[b] runs on the outside cell's side of the corner;
-            // carried on, it goes the other way, between the rows b − 1 and b.
-            let step_i: isize = if oi < a { 1 } else { -1 };
-            let mut i = if oi < a { a } else { a - 1 };
-            while is_in(i, b - 1) && is_in(i, b) {
-                hcut[b as usize * ns + i as usize] = true;
-                i += step_i;
-            }
-            let step_j: isize = if oj < b { 1 } else { -1 };
-            let mut j = if oj < b { b } else { b - 1 };
-            while is_in(a - 1, j) && is_in(a, j) {
+            if inside_pair((a - 1, j), (a, j)) && !open((a - 1, j), (a, j)) {
                 vcut[j as usize * (ns + 1) + a as usize] = true;
-                j += step_j;
+            }
+        }
+    }
+    for b in 1..nt as isize {
+        for i in 0..ns as isize {
+            if inside_pair((i, b - 1), (i, b)) && !open((i, b - 1), (i, b)) {
+                hcut[b as usize * ns + i as usize] = true;
+            }
+        }
+    }
+    let (walls_v, walls_h) = (vcut.clone(), hcut.clone());
+    // A side is boundary when one of its cells is outside, or it is a wall.
+    let h_boundary = |i: isize, b: isize| {
+        (at(i, b - 1).is_some() != at(i, b).is_some())
+            || (i >= 0
+                && (i as usize) < ns
+                && b >= 1
+                && (b as usize) < nt
+                && walls_h[b as usize * ns + i as usize])
+    };
+    let v_boundary = |a: isize, j: isize| {
+        (at(a - 1, j).is_some() != at(a, j).is_some())
+            || (j >= 0
+                && (j as usize) < nt
+                && a >= 1
+                && (a as usize) < ns
+                && walls_v[j as usize * (ns + 1) + a as usize])
+    };
+    // At every grid point, a boundary side that ends there while the line runs on between
+    // two inside cells is carried on until it meets the boundary.
+    for b in 0..=nt as isize {
+        for a in 0..=ns as isize {
+            // Along t[b]: the side to the left (column a − 1) and to the right (column a).
+            for (from, step) in [(a - 1, 1isize), (a, -1isize)] {
+                let ahead = from + step;
+                if !h_boundary(from, b) || h_boundary(ahead, b) {
+                    continue;
+                }
+                let mut i = ahead;
+                while inside_pair((i, b - 1), (i, b)) && !walls_h[b as usize * ns + i as usize] {
+                    hcut[b as usize * ns + i as usize] = true;
+                    i += step;
+                }
+            }
+            // Along s[a]: the side below (row b − 1) and above (row b).
+            for (from, step) in [(b - 1, 1isize), (b, -1isize)] {
+                let ahead = from + step;
+                if !v_boundary(a, from) || v_boundary(a, ahead) {
+                    continue;
+                }
+                let mut j = ahead;
+                while inside_pair((a - 1, j), (a, j))
+                    && !walls_v[j as usize * (ns + 1) + a as usize]
+                {
+                    vcut[j as usize * (ns + 1) + a as usize] = true;
+                    j += step;
+                }
             }
         }
     }
@@ -73,7 +127,7 @@ pub fn cut_at_concave_corners(faces: &[[f64; 4]], tol: f64) -> Option<Vec<[f64; 
     let mut region = vec![usize::MAX; ns * nt];
     let mut out = Vec::new();
     for start in 0..ns * nt {
-        if !inside[start] || region[start] != usize::MAX {
+        if face_of[start].is_none() || region[start] != usize::MAX {
             continue;
         }
         let id = out.len();
@@ -87,7 +141,7 @@ pub fn cut_at_concave_corners(faces: &[[f64; 4]], tol: f64) -> Option<Vec<[f64; 
             lo = [lo[0].min(i), lo[1].min(j)];
             hi = [hi[0].max(i + 1), hi[1].max(j + 1)];
             let mut next = |ok: bool, n: usize| {
-                if ok && inside[n] && region[n] == usize::MAX {
+                if ok && face_of[n].is_some() && region[n] == usize::MAX {
                     region[n] = id;
                     stack.push(n);
                 }
@@ -128,7 +182,7 @@ mod tests {
     fn an_l_shape_is_cut_once_at_its_concave_corner() {
         // 2 × 2 less the top-right square: the corner (1, 1) carries both sides on, the
         // regions are the three squares.
-        let r = cut_at_concave_corners(&grid_without(2, &[(1, 1)]), 1e-9).unwrap();
+        let r = cut_at_concave_corners(&grid_without(2, &[(1, 1)]), &|_, _| true, 1e-9).unwrap();
         assert_eq!(r, squares(&[(0, 0), (1, 0), (0, 1)]));
     }
 
@@ -136,7 +190,7 @@ mod tests {
     fn a_hole_cuts_the_lines_through_its_sides_and_nothing_else() {
         // 5 × 5 with a hole at (2, 2): the lines s = 2, 3 and t = 2, 3 run across; the knot
         // lines s = 1, 4 and t = 1, 4 cut nothing: 3 × 3 regions less the hole.
-        let r = cut_at_concave_corners(&grid_without(5, &[(2, 2)]), 1e-9).unwrap();
+        let r = cut_at_concave_corners(&grid_without(5, &[(2, 2)]), &|_, _| true, 1e-9).unwrap();
         let spans = [(0.0, 2.0), (2.0, 3.0), (3.0, 5.0)];
         let mut want = Vec::new();
         for (k, &(t0, t1)) in spans.iter().enumerate() {
@@ -153,7 +207,8 @@ mod tests {
     fn lines_stop_at_the_boundary_they_reach() {
         // A notch from the top, (2, 3) and (2, 4) out of 5 × 5: its two bottom corners carry
         // t = 3 outwards and s = 2, 3 down; above t = 3 nothing crosses s = 1 or s = 4.
-        let r = cut_at_concave_corners(&grid_without(5, &[(2, 3), (2, 4)]), 1e-9).unwrap();
+        let r = cut_at_concave_corners(&grid_without(5, &[(2, 3), (2, 4)]), &|_, _| true, 1e-9)
+            .unwrap();
         assert_eq!(
             r,
             vec![
@@ -171,11 +226,34 @@ mod tests {
     }
 
     #[test]
+    fn a_crease_is_cut_and_carried_on_past_its_ends() {
+        // 3 × 3 squares (face j * 3 + i at (i, j)); the faces either side of s = 1 are not
+        // joined in the rows `rows`: a crease there, whether it starts on the boundary or
+        // lies inside. It is cut and carried on to the boundary, and nothing else is cut.
+        let faces = grid_without(3, &[]);
+        for rows in [&[0, 1][..], &[1][..]] {
+            let joined = |f: usize, g: usize| {
+                let (a, b) = (f.min(g), f.max(g));
+                !rows.iter().any(|&j| a == 3 * j && b == 3 * j + 1)
+            };
+            let r = cut_at_concave_corners(&faces, &joined, 1e-9).unwrap();
+            assert_eq!(
+                r,
+                vec![[0.0, 1.0, 0.0, 3.0], [1.0, 3.0, 0.0, 3.0]],
+                "{rows:?}"
+            );
+        }
+        // Joined everywhere: one region.
+        let r = cut_at_concave_corners(&faces, &|_, _| true, 1e-9).unwrap();
+        assert_eq!(r, vec![[0.0, 3.0, 0.0, 3.0]]);
+    }
+
+    #[test]
     fn regions_meet_corner_to_corner() {
         // Two holes in one column and a notch: no region's corner lies inside another
         // region's side.
         let faces = grid_without(7, &[(3, 1), (3, 4), (0, 6), (1, 6)]);
-        let r = cut_at_concave_corners(&faces, 1e-9).unwrap();
+        let r = cut_at_concave_corners(&faces, &|_, _| true, 1e-9).unwrap();
         for a in &r {
             for corner in [[a[0], a[2]], [a[1], a[2]], [a[0], a[3]], [a[1], a[3]]] {
                 for b in &r {

@@ -6,7 +6,9 @@
 //! boundary), straight on through regular vertices and across faces at T-junction stems,
 //! until they reach the boundary, an extraordinary point, or a vertex another line has
 //! passed. The faces are cut along those lines into cells; cells joined across uncut edges
-//! form the patches.
+//! form the patches. A model whose cells all lie in one chart without filling a rectangle
+//! is instead cut only where its concave corners and creases need it ([`cuts`]): the
+//! fewest rectangles meeting corner to corner.
 //!
 //! Owns: tracing, cells, patch charts and connections, and patch evaluation. Must not:
 //! change the mesh or the surface.
@@ -392,7 +394,13 @@ impl PatchLayout {
         // a slot in the outline): cut at its concave corners, not a patch per cell.
         if let [Some(whole)] = placed.as_slice() {
             if as_rectangle(&cells, whole.clone()).is_none() {
-                if let Some(layout) = chart_layout(surface, &cells, whole) {
+                // Cells the mesh joins along an edge of positive knot interval: side by side
+                // in the chart without such a link, they meet across a crease.
+                let linked: std::collections::HashSet<(usize, usize)> = links
+                    .iter()
+                    .map(|&(a, b, ..)| (a.min(b), a.max(b)))
+                    .collect();
+                if let Some(layout) = chart_layout(surface, &cells, whole, &linked) {
                     return layout;
                 }
             }
@@ -673,12 +681,14 @@ fn as_rectangle(
 
 /// The layout of a model whose cells (all of them, `placed` in one chart) do not fill a
 /// rectangle (a notch in the outline, a hole without the lines that would cut round it):
-/// the chart cut at its concave corners ([`cuts::cut_at_concave_corners`]), each region one
-/// patch. `None` if a region is not a rectangle.
+/// the chart cut at its concave corners and along creases (sides between cells not in
+/// `linked`) ([`cuts::cut_at_concave_corners`]), each region one patch. `None` if a region
+/// is not a rectangle or a patch's faces do not fill it.
 fn chart_layout(
     surface: &Surface,
     cells: &Cells,
     placed: &[(usize, Placement)],
+    linked: &std::collections::HashSet<(usize, usize)>,
 ) -> Option<PatchLayout> {
     let mut placements = vec![
         crate::tmesh::walk::Placement {
@@ -707,13 +717,13 @@ fn chart_layout(
         .iter()
         .map(|r| (r[1] - r[0]).max(r[3] - r[2]))
         .fold(0.0f64, f64::max);
-    let rects = cuts::cut_at_concave_corners(&chart, KNOT_MATCH_REL * size.max(1.0))?;
+    let joined = |i: usize, j: usize| {
+        let (a, b) = (placed[i].0, placed[j].0);
+        linked.contains(&(a.min(b), a.max(b)))
+    };
+    let rects = cuts::cut_at_concave_corners(&chart, &joined, KNOT_MATCH_REL * size.max(1.0))?;
     PatchLayout::from_chart_rects(surface, &placements, &rects)
 }
-
-/// Face parameters (dimensionless) this close to a face's side are on it: the round trip
-/// through a chart (offset, quarter turns) moves them by a few ulps.
-const FACE_SIDE_SNAP: f64 = 1e-12;
 
 /// Relative mismatch between a chart rectangle's area and the face parts inside it above
 /// which faces do not fill it.
@@ -755,8 +765,9 @@ impl Patch {
 
     /// The patch covering the chart rectangle `rect` = `[s0, s1, t0, t1]` of a domain whose
     /// faces (indices into [`Surface::faces`]) lie in one chart under `placements` (by mesh
-    /// face): the parts of the faces inside it as pieces. `None` if faces do not fill the
-    /// rectangle (a hole or the boundary cuts into it) or it has no area.
+    /// face): the parts of the faces inside it as pieces (a face whose side lies on the
+    /// rectangle's only to rounding gives no piece a few ulps wide). `None` if faces do not
+    /// fill the rectangle (a hole or the boundary cuts into it) or it has no area.
     pub fn from_chart_rect(
         surface: &Surface,
         placements: &[crate::tmesh::walk::Placement],
@@ -777,9 +788,14 @@ impl Patch {
                 [a[0].max(rect[0]), a[1].max(rect[2])],
                 [b[0].min(rect[1]), b[1].min(rect[3])],
             );
+            if !(hi[0] > lo[0] && hi[1] > lo[1]) {
+                continue;
+            }
             // A face whose side lies on the rectangle's side only to rounding would leave a
-            // piece a few ulps wide (and its neighbour a few ulps short of its side).
-            if !(hi[0] - lo[0] > tol && hi[1] - lo[1] > tol) {
+            // piece a few ulps wide (and its neighbour a few ulps short of its side); a face
+            // that is itself that thin is kept.
+            let clipped_thin = |k: usize| hi[k] - lo[k] <= tol && b[k] - a[k] > tol;
+            if clipped_thin(0) || clipped_thin(1) {
                 continue;
             }
             area += (hi[0] - lo[0]) * (hi[1] - lo[1]);
@@ -952,26 +968,36 @@ impl Patch {
             };
             let (x, y) = (back(clo), back(chi));
             let face = &surface.faces()[p.face as usize];
-            // A footprint reaching the piece's side reaches the face's side: the round trip
-            // through the chart must not leave it a few ulps short (a sample on the side would
-            // fall outside the rest area).
-            let unit = |v: f64, size: f64| {
-                let t = (v / size).clamp(0.0, 1.0);
-                if t <= FACE_SIDE_SNAP {
-                    0.0
-                } else if t >= 1.0 - FACE_SIDE_SNAP {
-                    1.0
+            // A footprint reaching the piece's side reaches exactly the piece's own bound
+            // (which the neighbouring patch's piece of the face shares bit for bit): the round
+            // trip through the chart must not leave it a few ulps short, or a sample on that
+            // line would fall outside the rest area of both.
+            let tol = KNOT_MATCH_REL * self.width.max(self.height);
+            let snap = |v: f64, lo: f64, hi: f64| {
+                if (v - lo).abs() <= tol {
+                    lo
+                } else if (v - hi).abs() <= tol {
+                    hi
                 } else {
-                    t
+                    v
                 }
             };
+            let (l0, l1) = (
+                snap(x[0].min(y[0]), p.local[0], p.local[1]),
+                snap(x[0].max(y[0]), p.local[0], p.local[1]),
+            );
+            let (m0, m1) = (
+                snap(x[1].min(y[1]), p.local[2], p.local[3]),
+                snap(x[1].max(y[1]), p.local[2], p.local[3]),
+            );
+            let unit = |v: f64, size: f64| (v / size).clamp(0.0, 1.0);
             out.push((
                 p.face,
                 [
-                    unit(x[0].min(y[0]), face.width),
-                    unit(x[0].max(y[0]), face.width),
-                    unit(x[1].min(y[1]), face.height),
-                    unit(x[1].max(y[1]), face.height),
+                    unit(l0, face.width),
+                    unit(l1, face.width),
+                    unit(m0, face.height),
+                    unit(m1, face.height),
                 ],
             ));
         }
