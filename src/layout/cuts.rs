@@ -31,14 +31,17 @@ pub fn cut_at_concave_corners(
     }
     let [s, t] = &lines;
     let (ns, nt) = (s.len().checked_sub(1)?, t.len().checked_sub(1)?);
-    // The face holding each cell of the grid of all face sides, if any.
+    // The face holding each cell of the grid of all face sides, if any: each face fills the
+    // cells between the lines its sides lie on (found by bisection, within `tol`).
+    let line_at = |l: &[f64], x: f64| l.partition_point(|&y| y < x - tol).min(l.len() - 1);
     let mut face_of = vec![None; ns * nt];
-    for j in 0..nt {
-        for i in 0..ns {
-            let c = [0.5 * (s[i] + s[i + 1]), 0.5 * (t[j] + t[j + 1])];
-            face_of[j * ns + i] = faces
-                .iter()
-                .position(|r| c[0] >= r[0] && c[0] <= r[1] && c[1] >= r[2] && c[1] <= r[3]);
+    for (f, r) in faces.iter().enumerate() {
+        let (i0, i1) = (line_at(s, r[0]), line_at(s, r[1]));
+        let (j0, j1) = (line_at(t, r[2]), line_at(t, r[3]));
+        for j in j0..j1 {
+            for i in i0..i1 {
+                face_of[j * ns + i].get_or_insert(f);
+            }
         }
     }
     let at = |i: isize, j: isize| -> Option<usize> {
@@ -246,6 +249,19 @@ mod tests {
         // Joined everywhere: one region.
         let r = cut_at_concave_corners(&faces, &|_, _| true, 1e-9).unwrap();
         assert_eq!(r, vec![[0.0, 3.0, 0.0, 3.0]]);
+    }
+
+    #[test]
+    fn a_large_chart_is_cut_by_its_holes_lines_only() {
+        // 200 × 200 faces with two one-face holes: the lines through the holes' sides run
+        // across, 5 × 5 regions less the holes (every face is placed by bisection on the
+        // lines, not tested against every cell).
+        let faces = grid_without(200, &[(50, 50), (120, 80)]);
+        let r = cut_at_concave_corners(&faces, &|_, _| true, 1e-9).unwrap();
+        assert_eq!(r.len(), 23);
+        let area: f64 = r.iter().map(|q| (q[1] - q[0]) * (q[3] - q[2])).sum();
+        assert_eq!(area, faces.len() as f64);
+        assert!(r.contains(&[51.0, 120.0, 51.0, 80.0]));
     }
 
     #[test]
