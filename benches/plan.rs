@@ -104,25 +104,7 @@ fn bench_plan(c: &mut Criterion) {
 fn bench_scaling(c: &mut Criterion) {
     let mut group = c.benchmark_group("scaling");
     group.sample_size(10);
-    // Area by the midpoint rule, 32 × 32 points per face.
-    let area = |m: &tspath::Model| -> f64 {
-        let n = 32;
-        let mid = |k: usize| (k as f64 + 0.5) / n as f64;
-        m.surface
-            .faces()
-            .iter()
-            .map(|f| {
-                let mut a = 0.0;
-                for i in 0..n {
-                    for j in 0..n {
-                        let d = f.derivs(mid(i), mid(j));
-                        a += d.su.cross(&d.sv).norm();
-                    }
-                }
-                a / (n * n) as f64
-            })
-            .sum()
-    };
+    let area = tspath::plan::compare::area_mm2;
     let say = |label: &str, m: &tspath::Model, o: &PlanOptions| {
         let n = whole_plan(m, o);
         println!(

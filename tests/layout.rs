@@ -243,8 +243,8 @@ fn a_model_in_one_chart_that_is_no_rectangle_is_cut_only_at_its_concave_corners(
         let patches = m.layout.patches.len();
         println!("{file}: {patches} patches (were {before})");
         assert_eq!(patches, now, "{file}");
-        // Area by the midpoint rule on each face and on each patch: two parametrisations of
-        // the same surface.
+        // Area by the midpoint rule on each face, and as the comparison takes it on each
+        // patch: two parametrisations of the same surface.
         let n = 96;
         let mid = |k: usize| (k as f64 + 0.5) / n as f64;
         let faces: f64 = m
@@ -262,21 +262,7 @@ fn a_model_in_one_chart_that_is_no_rectangle_is_cut_only_at_its_concave_corners(
                 a / (n * n) as f64
             })
             .sum();
-        let laid: f64 = m
-            .layout
-            .patches
-            .iter()
-            .map(|p| {
-                let mut a = 0.0;
-                for i in 0..n {
-                    for j in 0..n {
-                        let d = p.derivs(&m.surface, mid(i), mid(j));
-                        a += d.su.cross(&d.sv).norm();
-                    }
-                }
-                a / (n * n) as f64
-            })
-            .sum();
+        let laid = tspath::plan::compare::area_mm2(&m);
         println!("{file}: area {laid:.3} mm² by patch, {faces:.3} mm² by face");
         assert!(
             (laid - faces).abs() <= 2e-3 * faces,

@@ -392,29 +392,14 @@ fn rest_matches_the_uncut_area(
     // (an area smaller than that may lie between samples).
     let edge = v.uncut_edge_fraction * v.area_mm2 + v.area_mm2 / v.samples as f64;
     let rest = report.unreachable_area_mm2;
-    // The least share counted of each footprint left too tight (its area by the midpoint
-    // rule on 4 × 4 points).
-    let layout = planned.layout.as_ref().unwrap_or(&m.layout);
+    // The least share the plan counts of each footprint left too tight, of the footprint's
+    // area as the plan takes it.
     let floor: f64 = planned
         .rest
         .footprints
         .iter()
         .filter(|(_, why)| *why == reach::Why::TooTight)
-        .map(|(f, _)| {
-            let patch = &layout.patches[f.patch as usize];
-            let [u0, u1, v0, v1] = f.rect;
-            let n = 4;
-            let mut area = 0.0;
-            for i in 0..n {
-                for j in 0..n {
-                    let u = u0 + (u1 - u0) * (i as f64 + 0.5) / n as f64;
-                    let v = v0 + (v1 - v0) * (j as f64 + 0.5) / n as f64;
-                    let d = patch.derivs(&m.surface, u, v);
-                    area += d.su.cross(&d.sv).norm();
-                }
-            }
-            reach::LEAST_SHARE * area * (u1 - u0) * (v1 - v0) / (n * n) as f64
-        })
+        .map(|(f, _)| reach::LEAST_SHARE * f.area_mm2(m))
         .sum::<f64>()
         + 0.0; // (an empty sum is −0)
     println!(

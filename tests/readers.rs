@@ -6,6 +6,8 @@
 //! The fuzz test runs `DEFAULT_FUZZ_CASES` cases per format; `TSPATH_FUZZ_CASES=N` (or
 //! proptest's own `PROPTEST_CASES=N`) runs more.
 
+mod support;
+
 use proptest::prelude::*;
 use serde_json::{json, Value};
 use tspath::error::Error;
@@ -497,26 +499,11 @@ fn json_unused_point_between_used_ones() {
 
 /// An `n × m` grid of quads, vertices numbered row by row from 1, gently curved.
 fn obj_grid(n: usize, m: usize) -> String {
-    let mut s = String::from("# grid\n");
-    for j in 0..=m {
-        for i in 0..=n {
-            let (x, y) = (i as f64 * 10.0, j as f64 * 10.0);
-            s += &format!("v {x} {y} {}\n", 0.01 * (x - 15.0) * (y - 10.0));
-        }
-    }
-    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
-    for j in 0..m {
-        for i in 0..n {
-            s += &format!(
-                "f {} {} {} {}\n",
-                id(i, j),
-                id(i + 1, j),
-                id(i + 1, j + 1),
-                id(i, j + 1)
-            );
-        }
-    }
-    s
+    let grid = support::quad_grid_obj(n, m, |i, j| {
+        let (x, y) = (i as f64 * 10.0, j as f64 * 10.0);
+        [x, y, 0.01 * (x - 15.0) * (y - 10.0)]
+    });
+    format!("# grid\n{grid}")
 }
 
 /// A cube cage (eight extraordinary points of valence 3), with texture/normal indices.

@@ -261,21 +261,18 @@ pub fn torus_obj(big: f64, small: f64, m: usize, n: usize) -> String {
     s
 }
 
-/// A sheet of `n` × `n` unit quads with a bumpy height, vertices numbered from 0 row by row
-/// (`j * (n + 1) + i`), faces from 0 row by row (`j * n + i`), as OBJ text.
-pub fn bumpy_sheet(n: usize) -> String {
+/// An `n × m` grid of quads as OBJ text: vertex `(i, j)` at `at(i, j)`, numbered from 1
+/// row by row (`j * (n + 1) + i + 1`), faces row by row (`j * n + i`).
+pub fn quad_grid_obj(n: usize, m: usize, at: impl Fn(usize, usize) -> [f64; 3]) -> String {
     let mut s = String::new();
-    for j in 0..=n {
+    for j in 0..=m {
         for i in 0..=n {
-            let (x, y) = (i as f64, j as f64);
-            s += &format!(
-                "v {x} {y} {}\n",
-                0.3 * (1.3 * x).sin() * (0.9 * y).cos() + 0.05 * x * y
-            );
+            let [x, y, z] = at(i, j);
+            s += &format!("v {x} {y} {z}\n");
         }
     }
     let id = |i: usize, j: usize| j * (n + 1) + i + 1;
-    for j in 0..n {
+    for j in 0..m {
         for i in 0..n {
             s += &format!(
                 "f {} {} {} {}\n",
@@ -287,6 +284,15 @@ pub fn bumpy_sheet(n: usize) -> String {
         }
     }
     s
+}
+
+/// A sheet of `n` × `n` unit quads with a bumpy height, vertices numbered from 0 row by row
+/// (`j * (n + 1) + i`), faces from 0 row by row (`j * n + i`), as OBJ text.
+pub fn bumpy_sheet(n: usize) -> String {
+    quad_grid_obj(n, n, |i, j| {
+        let (x, y) = (i as f64, j as f64);
+        [x, y, 0.3 * (1.3 * x).sin() * (0.9 * y).cos() + 0.05 * x * y]
+    })
 }
 
 /// A `t crease` tag creasing the edges along the vertex chain `chain` (counted from 0) with
