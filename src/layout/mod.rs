@@ -390,27 +390,35 @@ impl PatchLayout {
             .iter()
             .map(|comp| place_cells(mesh, &cells, comp, &adjacency))
             .collect();
+        // Where each placed component's bounding box starts, if the cells fill it.
+        let origins: Vec<Option<[f64; 2]>> = placed
+            .iter()
+            .map(|p| p.as_deref().and_then(|p| rectangle_origin(&cells, p)))
+            .collect();
         // One component in one chart that is not a rectangle (face.tsm: two holes; Bike.tsm:
         // a slot in the outline): cut at its concave corners, not a patch per cell.
-        if let [Some(whole)] = placed.as_slice() {
-            if as_rectangle(&cells, whole.clone()).is_none() {
-                // Cells the mesh joins along an edge of positive knot interval: side by side
-                // in the chart without such a link, they meet across a crease.
-                let linked: std::collections::HashSet<(usize, usize)> = links
-                    .iter()
-                    .map(|&(a, b, ..)| (a.min(b), a.max(b)))
-                    .collect();
-                if let Some(layout) = chart_layout(surface, &cells, whole, &linked) {
-                    return layout;
-                }
+        if let ([Some(whole)], [None]) = (placed.as_slice(), origins.as_slice()) {
+            // Cells the mesh joins along an edge of positive knot interval: side by side in
+            // the chart without such a link, they meet across a crease.
+            let linked: std::collections::HashSet<(usize, usize)> = links
+                .iter()
+                .map(|&(a, b, ..)| (a.min(b), a.max(b)))
+                .collect();
+            if let Some(layout) = chart_layout(surface, &cells, whole, &linked) {
+                return layout;
             }
         }
         let mut patches: Vec<Patch> = Vec::new();
         let mut patch_of_cell = vec![0u32; n];
-        for (comp, placed) in comps.iter().zip(placed) {
-            let placed = placed.and_then(|p| as_rectangle(&cells, p));
-            let chunks: Vec<Vec<(usize, Placement)>> = match placed {
-                Some(p) => vec![p],
+        for ((comp, placed), origin) in comps.iter().zip(placed).zip(origins) {
+            let chunks: Vec<Vec<(usize, Placement)>> = match placed.zip(origin) {
+                // The chart moved so that the rectangle starts at its origin.
+                Some((mut p, lo)) => {
+                    for (_, pl) in p.iter_mut() {
+                        pl.1 = [pl.1[0] - lo[0], pl.1[1] - lo[1]];
+                    }
+                    vec![p]
+                }
                 // Not a rectangle (e.g. a band closing on itself): one patch per cell.
                 None => comp.iter().map(|&c| vec![(c, (0, [0.0, 0.0]))]).collect(),
             };
@@ -653,30 +661,21 @@ fn place_cells(
     Some(comp.iter().map(|&c| (c, placed[&c])).collect())
 }
 
-/// The placements of `place_cells` moved so that the cells' bounding box starts at the
-/// chart's origin, if the cells fill that box (a rectangle).
-fn as_rectangle(
-    cells: &Cells,
-    mut placed: Vec<(usize, Placement)>,
-) -> Option<Vec<(usize, Placement)>> {
+/// Where the bounding box of the placed cells starts in the chart, if the cells fill it
+/// (a rectangle).
+fn rectangle_origin(cells: &Cells, placed: &[(usize, Placement)]) -> Option<[f64; 2]> {
     // Rectangle check: the cells' areas add up to their bounding box.
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     let mut area = 0.0;
-    for &(c, pl) in &placed {
+    for &(c, pl) in placed {
         let (a, b) = chart_rect(&cells.cells[c].rect, pl);
         lo = [lo[0].min(a[0]), lo[1].min(a[1])];
         hi = [hi[0].max(b[0]), hi[1].max(b[1])];
         area += (b[0] - a[0]) * (b[1] - a[1]);
     }
     let box_area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
-    if !(box_area > 0.0) || (area - box_area).abs() > RECT_FILL_REL * box_area {
-        return None;
-    }
-    for (_, pl) in placed.iter_mut() {
-        pl.1 = [pl.1[0] - lo[0], pl.1[1] - lo[1]];
-    }
-    Some(placed)
+    (box_area > 0.0 && (area - box_area).abs() <= RECT_FILL_REL * box_area).then_some(lo)
 }
 
 /// The layout of a model whose cells (all of them, `placed` in one chart) do not fill a
