@@ -1,6 +1,8 @@
 //! Patch layouts: counts, coverage, rectangular charts whose evaluation matches the faces
 //! (derivatives against differences), extraordinary points at patch corners, connections.
 
+mod support;
+
 use tspath::layout::ConnectionKind;
 use tspath::model::samples::{self, SAMPLES};
 use tspath::Model;
@@ -216,8 +218,7 @@ fn a_model_in_one_chart_that_is_no_rectangle_is_cut_only_at_its_concave_corners(
     // side of both patches, so the patch order can pass at a shared corner), and (issue 13)
     // every boundary connection a stretch of side the two patches really share.
     for (file, before, now) in [("Bike.tsm", 81, 5), ("face.tsm", 135, 13)] {
-        let path = format!("{}/www/models/grapetec/{file}", env!("CARGO_MANIFEST_DIR"));
-        let m = tspath::io::load(&std::fs::read(&path).unwrap(), file).unwrap();
+        let m = support::public_tsm(file);
         let tol = 1e-7 * m.surface.bbox().diagonal();
         let side = |p: &tspath::layout::Patch, s: u8, n: usize| -> Vec<tspath::geom::Point3> {
             (0..=n)
@@ -300,8 +301,7 @@ fn a_rectangle_reaching_a_patch_side_reaches_its_faces_sides() {
     // sides exactly at 0 or 1 where they reach the face's, and where two patches share a
     // face, exactly (bit for bit) where the other's piece begins.
     for file in ["Bike.tsm", "face.tsm", "mouse.tsm"] {
-        let path = format!("{}/www/models/grapetec/{file}", env!("CARGO_MANIFEST_DIR"));
-        let m = tspath::io::load(&std::fs::read(&path).unwrap(), file).unwrap();
+        let m = support::public_tsm(file);
         let mut rects: Vec<Vec<[f64; 4]>> = vec![Vec::new(); m.surface.faces().len()];
         for p in &m.layout.patches {
             for (face, r) in p.face_rects(&m.surface, [0.0, 1.0, 0.0, 1.0]) {

@@ -222,10 +222,9 @@ mod tests {
                 [3.0, 5.0, 3.0, 5.0],
             ]
         );
-        // The regions cover the faces once, and every corner of a region inside the domain
-        // is a corner of each region it touches (no T-junction between regions).
-        let area: f64 = r.iter().map(|q| (q[1] - q[0]) * (q[3] - q[2])).sum();
-        assert_eq!(area, 23.0);
+        // Every corner of a region inside the domain is a corner of each region it touches
+        // (no T-junction between regions).
+        assert_corner_to_corner(&r, 23.0);
     }
 
     #[test]
@@ -259,20 +258,16 @@ mod tests {
         let faces = grid_without(200, &[(50, 50), (120, 80)]);
         let r = cut_at_concave_corners(&faces, &|_, _| true, 1e-9).unwrap();
         assert_eq!(r.len(), 23);
-        let area: f64 = r.iter().map(|q| (q[1] - q[0]) * (q[3] - q[2])).sum();
-        assert_eq!(area, faces.len() as f64);
+        assert_corner_to_corner(&r, faces.len() as f64);
         assert!(r.contains(&[51.0, 120.0, 51.0, 80.0]));
     }
 
-    #[test]
-    fn regions_meet_corner_to_corner() {
-        // Two holes in one column and a notch: no region's corner lies inside another
-        // region's side.
-        let faces = grid_without(7, &[(3, 1), (3, 4), (0, 6), (1, 6)]);
-        let r = cut_at_concave_corners(&faces, &|_, _| true, 1e-9).unwrap();
-        for a in &r {
+    /// No region's corner lies inside another region's side, and the regions cover
+    /// `area` once.
+    fn assert_corner_to_corner(r: &[[f64; 4]], area: f64) {
+        for a in r {
             for corner in [[a[0], a[2]], [a[1], a[2]], [a[0], a[3]], [a[1], a[3]]] {
-                for b in &r {
+                for b in r {
                     let on_s = (corner[0] == b[0] || corner[0] == b[1])
                         && corner[1] > b[2]
                         && corner[1] < b[3];
@@ -286,7 +281,15 @@ mod tests {
                 }
             }
         }
-        let area: f64 = r.iter().map(|q| (q[1] - q[0]) * (q[3] - q[2])).sum();
-        assert_eq!(area, faces.len() as f64);
+        let total: f64 = r.iter().map(|q| (q[1] - q[0]) * (q[3] - q[2])).sum();
+        assert_eq!(total, area);
+    }
+
+    #[test]
+    fn regions_meet_corner_to_corner() {
+        // Two holes in one column and a notch.
+        let faces = grid_without(7, &[(3, 1), (3, 4), (0, 6), (1, 6)]);
+        let r = cut_at_concave_corners(&faces, &|_, _| true, 1e-9).unwrap();
+        assert_corner_to_corner(&r, faces.len() as f64);
     }
 }

@@ -724,6 +724,17 @@ fn chart_layout(
     PatchLayout::from_chart_rects(surface, &placements, &rects)
 }
 
+/// `v` moved onto `lo` or `hi` if within `tol` of it.
+fn snap_to(v: f64, lo: f64, hi: f64, tol: f64) -> f64 {
+    if (v - lo).abs() <= tol {
+        lo
+    } else if (v - hi).abs() <= tol {
+        hi
+    } else {
+        v
+    }
+}
+
 /// Relative mismatch between a chart rectangle's area and the face parts inside it above
 /// which faces do not fill it.
 const RECT_FILL_REL: f64 = 1e-9;
@@ -800,15 +811,7 @@ impl Patch {
             area += (hi[0] - lo[0]) * (hi[1] - lo[1]);
             let back = |c: [f64; 2]| rot((4 - k) % 4, [c[0] - off[0], c[1] - off[1]]);
             let (x, y) = (back(lo), back(hi));
-            let snap = |v: f64, size: f64| {
-                if v.abs() <= tol {
-                    0.0
-                } else if (v - size).abs() <= tol {
-                    size
-                } else {
-                    v.clamp(0.0, size)
-                }
-            };
+            let snap = |v: f64, size: f64| snap_to(v, 0.0, size, tol).clamp(0.0, size);
             pieces.push(Piece {
                 face: fi as u32,
                 local: [
@@ -949,6 +952,7 @@ impl Patch {
         let lo = [rect[0] * self.width, rect[2] * self.height];
         let hi = [rect[1] * self.width, rect[3] * self.height];
         let mut out = Vec::new();
+        let tol = KNOT_MATCH_REL * self.width.max(self.height);
         for p in &self.pieces {
             let (a, b) = chart_rect(&p.local, (p.quarter_turns, p.offset));
             let (clo, chi) = (
@@ -971,16 +975,7 @@ impl Patch {
             // (which the neighbouring patch's piece of the face shares bit for bit): the round
             // trip through the chart must not leave it a few ulps short, or a sample on that
             // line would fall outside the rest area of both.
-            let tol = KNOT_MATCH_REL * self.width.max(self.height);
-            let snap = |v: f64, lo: f64, hi: f64| {
-                if (v - lo).abs() <= tol {
-                    lo
-                } else if (v - hi).abs() <= tol {
-                    hi
-                } else {
-                    v
-                }
-            };
+            let snap = |v: f64, lo: f64, hi: f64| snap_to(v, lo, hi, tol);
             let (l0, l1) = (
                 snap(x[0].min(y[0]), p.local[0], p.local[1]),
                 snap(x[0].max(y[0]), p.local[0], p.local[1]),
