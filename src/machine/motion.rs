@@ -35,8 +35,11 @@ use serde::{Deserialize, Serialize};
 const S_PER_MIN: f64 = 60.0;
 /// A move shorter than this in joint space (mm, or degrees for a turn) takes no time.
 const NULL_MOVE: f64 = 1e-12;
-/// Bisection steps of the speed searches (the interval halves each step).
+/// Most steps of the speed searches (each narrows the interval the speed lies in; a
+/// bisection step halves it).
 const BISECTION_STEPS: usize = 60;
+/// The peak speed search stops when the interval it lies in is this share of its top.
+const SPEED_REL_TOL: f64 = 1e-11;
 /// Most Newton steps of [`reach`]'s cubic (it converges in a few from its start; from a
 /// start far above a tiny root each step shrinks the root's bracket by at least a third).
 const NEWTON_STEPS: usize = 200;
@@ -187,6 +190,21 @@ fn change(a: f64, b: f64, accel: f64, jerk: f64) -> (f64, f64) {
     (t, 0.5 * (a + b) * t)
 }
 
+/// How fast the distance of the speed change between `a` and `v` ([`change`]) grows with
+/// `v ≥ a`: `t/2 + (a + v)/2 · dt/dv`, the time's rate `1/accel` where the change has a
+/// constant-acceleration part, `1/sqrt(j (v − a))` where it has not (infinite at `v = a`).
+fn distance_slope(a: f64, v: f64, accel: f64, jerk: f64) -> f64 {
+    let dv = (v - a).abs();
+    let (t, rate) = if !jerk.is_finite() {
+        (dv / accel, 1.0 / accel)
+    } else if dv >= accel * accel / jerk {
+        (dv / accel + accel / jerk, 1.0 / accel)
+    } else {
+        (2.0 * (dv / jerk).sqrt(), 1.0 / (dv * jerk).sqrt())
+    };
+    0.5 * t + 0.5 * (a + v) * rate
+}
+
 /// The highest speed reachable from `from` within `p` (never above `cap`): the speed change
 /// `x` whose S-curve ([`change`]) covers exactly `p`, in closed form where the curve has a
 /// constant-acceleration part (a quadratic in `x`) and by Newton's method where it has not
@@ -232,25 +250,49 @@ fn move_time(m: &Profile, v0: f64, v1: f64) -> f64 {
     if da + dd <= m.p {
         return ta + td + (m.p - da - dd) / m.top;
     }
-    // Never reaches the top speed: the peak where speeding up and braking fill the move.
-    let (mut lo, mut hi) = (v0.max(v1), m.top);
+    // Never reaches the top speed: the peak `v` where speeding up and braking fill the
+    // move, the root of `g(v) = distance(v0 → v) + distance(v → v1) − p`, which rises with
+    // `v` from `base = max(v0, v1)`. Its slope is infinite at `base` under a jerk limit
+    // (the time of a small change grows as its square root), and the peak often lies
+    // there (a move that only speeds up), so the search runs on `s = sqrt(v − base)`,
+    // where `g` is smooth: Newton's method inside the bracket `[lo, hi]` of `s` (a
+    // bisection step wherever Newton's would leave it), until the bracket or Newton's step
+    // is a few rounding steps wide.
+    let base = v0.max(v1);
+    let g = |v: f64| change(v0, v, m.accel, m.jerk).1 + change(v, v1, m.accel, m.jerk).1 - m.p;
+    let (mut lo, mut hi) = (0.0, (m.top - base).sqrt());
+    let mut s = hi;
     for _ in 0..BISECTION_STEPS {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            // Adjacent numbers: further steps leave `lo` as it is.
+        let v = base + s * s;
+        let gv = g(v);
+        if gv <= 0.0 {
+            lo = s;
+        } else {
+            hi = s;
+        }
+        if hi - lo <= SPEED_REL_TOL * hi {
             break;
         }
-        let d = change(v0, mid, m.accel, m.jerk).1 + change(mid, v1, m.accel, m.jerk).1;
-        if d <= m.p {
-            lo = mid;
-        } else {
-            hi = mid;
+        let slope = 2.0
+            * s
+            * (distance_slope(v0, v, m.accel, m.jerk) + distance_slope(v1, v, m.accel, m.jerk));
+        let newton = s - gv / slope;
+        if (newton - s).abs() <= SPEED_REL_TOL * hi {
+            // Within rounding of the root: the lower of the two.
+            lo = lo.max(newton.min(s));
+            break;
         }
+        s = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
     }
-    let (ta, da) = change(v0, lo, m.accel, m.jerk);
-    let (td, dd) = change(lo, v1, m.accel, m.jerk);
-    // What the bisection leaves of the move, at the peak speed.
-    ta + td + (m.p - da - dd).max(0.0) / lo.max(f64::MIN_POSITIVE)
+    let peak = base + lo * lo;
+    let (ta, da) = change(v0, peak, m.accel, m.jerk);
+    let (td, dd) = change(peak, v1, m.accel, m.jerk);
+    // What the search leaves of the move, at the peak speed.
+    ta + td + (m.p - da - dd).max(0.0) / peak.max(f64::MIN_POSITIVE)
 }
 
 /// The corner speed (in the corner rule's scaled joint space, per second) allowed between

@@ -345,7 +345,12 @@ pub fn slices(
     };
     let cut = |c: f64, tris: &[u32]| cut_plane(&mesh, &frame, &x_prime, c, tris, seam);
     // What is still too wide: passes added half-way between neighbours over that stretch.
+    // Each pass's check points are found once, when the pass is made.
     passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
+    let mut checks: Vec<PassChecks> = passes
+        .iter()
+        .map(|p| PassChecks::new(model, opts, &frame, p))
+        .collect();
     let mut added_planes = 0;
     let mut gap = step;
     let mut predicted: f64 = 0.0;
@@ -353,7 +358,7 @@ pub fn slices(
         // Each round's check reports over its share of 0.6 to 0.9.
         let span = CHECK_PROGRESS_SHARE / (MAX_SPLITS + 1) as f64;
         let lo = 0.6 + span * round as f64;
-        let (needs, worst) = too_wide(model, opts, &frame, &passes, gap, &mut |f| {
+        let (needs, worst) = too_wide(opts, &frame, &passes, &checks, gap, &mut |f| {
             progress(lo + span * f);
         });
         if !progress(lo + span) {
@@ -378,9 +383,13 @@ pub fn slices(
             if !kept.is_empty() {
                 added_planes += 1;
             }
+            checks.extend(kept.iter().map(|p| PassChecks::new(model, opts, &frame, p)));
             passes.extend(kept);
         }
-        passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
+        // Sorted by plane, the checks kept beside their passes (a stable sort, as before).
+        let mut both: Vec<(Pass, PassChecks)> = passes.into_iter().zip(checks).collect();
+        both.sort_by(|a, b| a.0.plane.total_cmp(&b.0.plane));
+        (passes, checks) = both.into_iter().unzip();
     }
     let planes = {
         let mut v: Vec<f64> = passes.iter().map(|p| p.plane).collect();
@@ -711,40 +720,22 @@ fn join_at_seams(mesh: &ClMesh, mut passes: Vec<Pass>, tol: f64) -> Vec<Pass> {
     }
 }
 
-/// Planes to add half-way between neighbours `gap` (mm, deformed) apart, with the CL points
-/// near which the cusp eq. 5 predicts from the contact points' distance to the other pass
-/// and the curvature across the feed is over the scallop, and the largest predicted there;
-/// and the largest predicted where it is not over.
-#[allow(clippy::type_complexity)]
-fn too_wide(
-    model: &Model,
-    opts: &PlanOptions,
-    frame: &Frame,
-    passes: &[Pass],
-    gap: f64,
-    tick: &mut dyn FnMut(f64),
-) -> (Vec<(f64, Vec<Point3>, f64)>, f64) {
-    let r = opts.tool_radius_mm;
-    let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
-    // Per plane: every pass point's contact point, CL point and curvature across the feed,
-    // and the pieces' contact polylines.
-    struct Plane {
-        c: f64,
-        points: Vec<(Point3, Point3, f64, Vector3)>,
-        segments: Vec<(Point3, Point3)>,
-    }
-    let mut planes: Vec<Plane> = Vec::new();
-    let n_passes = passes.len().max(1) as f64;
-    for (k, p) in passes.iter().enumerate() {
-        tick(0.5 * k as f64 / n_passes);
-        if planes.last().is_none_or(|x| x.c != p.plane) {
-            planes.push(Plane {
-                c: p.plane,
-                points: Vec::new(),
-                segments: Vec::new(),
-            });
-        }
-        let plane = planes.last_mut().expect("pushed");
+/// Where a pass is checked for the cusp beside it: every point a quarter spacing on from the
+/// last checked, and the last; each with its contact point, CL point, the curvature across
+/// the feed and the feed direction; and the contact polyline through them.
+struct PassChecks {
+    points: Vec<(Point3, Point3, f64, Vector3)>,
+    segments: Vec<(Point3, Point3)>,
+}
+
+impl PassChecks {
+    fn new(model: &Model, opts: &PlanOptions, frame: &Frame, p: &Pass) -> Self {
+        let r = opts.tool_radius_mm;
+        let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
+        let mut out = PassChecks {
+            points: Vec::new(),
+            segments: Vec::new(),
+        };
         let (mut last, mut last_cc): (Option<Point3>, Option<Point3>) = (None, None);
         let every = CHECK_EVERY_SHARE * (8.0 * r * h).sqrt();
         let n = p.points.len();
@@ -772,13 +763,52 @@ fn too_wide(
             };
             let c = g.normal.cross(&t);
             let kappa = curvature_along(&g, &d, &c);
-            plane.points.push((g.point, s.mesh_cl, kappa, t));
+            out.points.push((g.point, s.mesh_cl, kappa, t));
             if let Some(a) = last_cc {
-                plane.segments.push((a, g.point));
+                out.segments.push((a, g.point));
             }
             last = Some(s.mesh_cl);
             last_cc = Some(g.point);
         }
+        out
+    }
+}
+
+/// Planes to add half-way between neighbours `gap` (mm, deformed) apart, with the CL points
+/// near which the cusp eq. 5 predicts from the contact points' distance to the other pass
+/// and the curvature across the feed is over the scallop, and the largest predicted there;
+/// and the largest predicted where it is not over. `checks` are the passes' own.
+#[allow(clippy::type_complexity)]
+fn too_wide(
+    opts: &PlanOptions,
+    frame: &Frame,
+    passes: &[Pass],
+    checks: &[PassChecks],
+    gap: f64,
+    tick: &mut dyn FnMut(f64),
+) -> (Vec<(f64, Vec<Point3>, f64)>, f64) {
+    let r = opts.tool_radius_mm;
+    let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
+    // Per plane: the check points of its passes, and the pieces' contact polylines.
+    struct Plane {
+        c: f64,
+        points: Vec<(Point3, Point3, f64, Vector3)>,
+        segments: Vec<(Point3, Point3)>,
+    }
+    let mut planes: Vec<Plane> = Vec::new();
+    let n_passes = passes.len().max(1) as f64;
+    for (k, (p, check)) in passes.iter().zip(checks).enumerate() {
+        tick(0.5 * k as f64 / n_passes);
+        if planes.last().is_none_or(|x| x.c != p.plane) {
+            planes.push(Plane {
+                c: p.plane,
+                points: Vec::new(),
+                segments: Vec::new(),
+            });
+        }
+        let plane = planes.last_mut().expect("pushed");
+        plane.points.extend_from_slice(&check.points);
+        plane.segments.extend_from_slice(&check.segments);
     }
     let reach = CHECK_REACH_SPACINGS * (8.0 * r * h).sqrt();
     let mut out = Vec::new();
@@ -1134,12 +1164,32 @@ impl Emit<'_> {
         let mut keep = vec![0];
         let mut i = 0;
         while i + 1 < n {
-            let mut j = i + 1;
-            while j + 1 < n && j + 1 - i <= THIN_LOOKAHEAD && holds(i, j + 1) {
-                j += 1;
+            // The farthest end that holds, found by doubling the reach and then halving the
+            // gap between the last end that held and the first that did not (each test
+            // checks every point between, so this is a few tests where one by one was up
+            // to THIN_LOOKAHEAD of them).
+            let last = (n - 1).min(i + THIN_LOOKAHEAD);
+            let (mut held, mut failed) = (i + 1, last + 1);
+            let mut step = 1;
+            while held < last {
+                let j = (held + step).min(last);
+                if !holds(i, j) {
+                    failed = j;
+                    break;
+                }
+                held = j;
+                step *= 2;
             }
-            keep.push(j);
-            i = j;
+            while failed - held > 1 {
+                let j = held + (failed - held) / 2;
+                if holds(i, j) {
+                    held = j;
+                } else {
+                    failed = j;
+                }
+            }
+            keep.push(held);
+            i = held;
         }
         Ok(keep.into_iter().map(|k| points[k]).collect())
     }
