@@ -12,7 +12,8 @@
 // starting, loading, model-loaded, planning, planned or error; `data-status` what the shown
 // plan's report says (`planned`, or `planned_with_problems` when it leaves something undone);
 // `data-verify` whether the cutting simulation is running, done or failed; `data-stale`
-// that the parameters no longer match the plan shown (its downloads are off).
+// that the parameters no longer match the plan shown (its downloads are off);
+// `data-plan-to-final-ms` the time from Plan to the final heat map of the last plan simulated.
 import { GLOSSARY, markTerms } from './glossary.js';
 import { JOB_SUFFIX, isJob, readJob, writeJob } from './job.js';
 import { CancelledError, EngineClient } from './client.js';
@@ -1294,7 +1295,7 @@ export class TspathPlanner extends HTMLElement {
     this.#clearPlan();
     // `report` is what the page shows: the plan's own (`planReport`), and once simulated
     // the same with the simulation's findings added.
-    this.plan = { ...result, planReport: result.report, options, values, workerHasPlan: true };
+    this.plan = { ...result, planReport: result.report, options, values, workerHasPlan: true, startedAt: t0 };
     this.view.setPath(result);
     this.#showRest();
     for (const key of Object.keys(OVERLAYS)) this.#showOverlay(key);
@@ -1773,6 +1774,12 @@ export class TspathPlanner extends HTMLElement {
       plan.report = v.report;
       this.dataset.status = v.report.status;
       this.dataset.verify = 'done';
+      // From Plan to this final heat map, the first simulation of a plan only (tests and
+      // the timing script read it).
+      if (plan.startedAt !== this.lastFinalOf) {
+        this.dataset.planToFinalMs = String(Math.round(performance.now() - plan.startedAt));
+        this.lastFinalOf = plan.startedAt;
+      }
       this.$('colour-heat').disabled = false;
       this.#showStats();
       this.#showColours();

@@ -483,7 +483,9 @@ test('progressive simulation: a preview heat map from 100 000 samples shows whil
   const after = await page.textContent('#heat-legend');
   check(!/Preview/.test(after) && /0\.01 mm left/.test(after), `the final legend: ${after}`);
   const samples = (await stat(page, 'samples')).text;
-  return `from navigation: preview heat map after ${tPreview} ms, final after ${tFinal} ms (${samples} samples)`;
+  const fromPlan = Number(await attr(page, 'data-plan-to-final-ms'));
+  check(fromPlan > 0 && fromPlan <= tFinal, `Plan to final heat map ${fromPlan} ms, within the ${tFinal} ms from navigation`);
+  return `from navigation: preview heat map after ${tPreview} ms, final after ${tFinal} ms (${samples} samples); from Plan to the final map ${fromPlan} ms (planning ${(await stat(page, 'plan_ms')).text}, simulation ${(await stat(page, 'verify_ms')).text})`;
 });
 
 /** Drops a file on the view, as a user drags one from the desktop. */
