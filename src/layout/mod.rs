@@ -896,7 +896,16 @@ impl Patch {
     pub fn derivs(&self, surface: &Surface, u: f64, v: f64) -> SurfaceDerivs {
         let (p, [x, y]) = self.locate(u * self.width, v * self.height);
         let face = &surface.faces()[p.face as usize];
-        let d = face.derivs(x / face.width, y / face.height);
+        self.to_patch(p, face, face.derivs(x / face.width, y / face.height))
+    }
+
+    /// Face derivatives `d` of piece `p` in the patch's parameters.
+    fn to_patch(
+        &self,
+        p: &Piece,
+        face: &crate::surface::FaceSurface,
+        d: SurfaceDerivs,
+    ) -> SurfaceDerivs {
         let [j00, j10, j01, j11] = self.jacobian(p, face);
         SurfaceDerivs {
             point: d.point,
@@ -906,6 +915,23 @@ impl Patch {
             suv: d.suu * (j00 * j01) + d.suv * (j00 * j11 + j10 * j01) + d.svv * (j10 * j11),
             svv: d.suu * (j01 * j01) + d.suv * (2.0 * j01 * j11) + d.svv * (j11 * j11),
         }
+    }
+
+    /// [`Patch::derivs`] and [`Patch::point_normal`]'s normal from one evaluation (the
+    /// normal the face's own, as there, bit for bit).
+    pub fn derivs_normal(
+        &self,
+        surface: &Surface,
+        u: f64,
+        v: f64,
+    ) -> (SurfaceDerivs, Option<crate::geom::Vector3>) {
+        let (p, [x, y]) = self.locate(u * self.width, v * self.height);
+        let face = &surface.faces()[p.face as usize];
+        let (a, b) = (x / face.width, y / face.height);
+        let d = face.derivs(a, b);
+        let normal =
+            crate::surface::diffgeom::unit_normal(&d.su, &d.sv).or_else(|| face.normal(a, b));
+        (self.to_patch(p, face, d), normal)
     }
 
     /// Point and first derivatives `(S, S_u, S_v)` at patch parameters `(u, v)`: those of

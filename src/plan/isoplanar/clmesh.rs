@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
 use crate::model::Model;
 use crate::plan::stepover;
-use crate::surface::DiffGeom;
+use crate::surface::{DiffGeom, SurfaceDerivs};
 
 /// A vertex of the CL mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,10 +49,31 @@ const SIZE_SAMPLES: usize = 9;
 /// Most vertices of the whole mesh: beyond it the grids are coarsened (evenly).
 const MAX_VERTICES: usize = 2_000_000;
 
+/// Takes a vertex's index and the surface's derivatives at its contact point (patch
+/// parameters) as [`ClMesh::new_with`] makes it.
+pub type VertexVisit<'a> = &'a mut dyn FnMut(usize, &SurfaceDerivs);
+
 impl ClMesh {
     /// The CL mesh of `model` for a ball of radius `r` (mm) within chordal tolerance
     /// `chordal_mm` of the true offset surface.
     pub fn new(model: &Model, r: f64, chordal_mm: f64) -> Result<Self> {
+        Self::build(model, r, chordal_mm, None)
+    }
+
+    /// [`ClMesh::new`], handing each vertex's index and the surface's derivatives there
+    /// (in the patch's parameters) to `each` as the vertex is made: one evaluation serves
+    /// the mesh and a caller that needs the curvature at every vertex. The mesh is the
+    /// same bit for bit (the point and first derivatives equal those evaluated alone).
+    pub fn new_with(model: &Model, r: f64, chordal_mm: f64, each: VertexVisit) -> Result<Self> {
+        Self::build(model, r, chordal_mm, Some(each))
+    }
+
+    fn build(
+        model: &Model,
+        r: f64,
+        chordal_mm: f64,
+        mut each: Option<VertexVisit>,
+    ) -> Result<Self> {
         let side = model.tool_side();
         let surface = &model.surface;
         let layout = &model.layout;
@@ -108,7 +129,14 @@ impl ClMesh {
             for j in 0..=nv {
                 for i in 0..=nu {
                     let uv = [i as f64 / nu as f64, j as f64 / nv as f64];
-                    let (cc, n) = patch.point_normal(surface, uv[0], uv[1]);
+                    let (cc, n) = match each.as_deref_mut() {
+                        Some(f) => {
+                            let (d, n) = patch.derivs_normal(surface, uv[0], uv[1]);
+                            f(vertices.len(), &d);
+                            (d.point, n)
+                        }
+                        None => patch.point_normal(surface, uv[0], uv[1]),
+                    };
                     vertices.push(n.map(|n| {
                         let normal = n * side;
                         ClVertex {

@@ -179,6 +179,41 @@ fn geometry(model: &Model, patch: u32, uv: [f64; 2]) -> Option<(SurfaceDerivs, D
     ))
 }
 
+/// The deformation ratio at a CL-mesh vertex whose contact point has patch derivatives `d`
+/// (from its exact normal and the curvature across the plane through it), and how much
+/// denser the curvature there asks the planes to be; `None` where there is no normal.
+fn vertex_ratio(
+    model: &Model,
+    frame: &Frame,
+    form: RatioForm,
+    r: f64,
+    d: &SurfaceDerivs,
+) -> Option<(f64, f64)> {
+    let g = DiffGeom::try_from_derivs(d)?;
+    let g = if model.tool_side() < 0.0 {
+        g.flipped()
+    } else {
+        g
+    };
+    let n = [g.normal.dot(&frame.x), g.normal.dot(&frame.y), g.normal.z];
+    // Slopes of the CL surface (its normal is the design surface's at the contact), from +Z
+    // or, on an underside, from −Z: the plane spacing depends only on how steeply the
+    // surface climbs in x.
+    let (p, q) = if n[2].abs() > 0.0 {
+        (-n[0] / n[2], -n[1] / n[2])
+    } else {
+        (f64::INFINITY, 0.0)
+    };
+    let (kx, ky) = match feed_frame(&g.normal, &frame.x) {
+        Some((t, across)) => (curvature_along(&g, d, &across), curvature_along(&g, d, &t)),
+        None => (0.0, 0.0),
+    };
+    Some((
+        deform::ratio(form, p, q, r, kx, ky),
+        deform::curvature_factor(r, kx),
+    ))
+}
+
 /// The parameter step `(du, dv)` whose tangent `S_u du + S_v dv` is the tangent-plane
 /// projection of `dir` (the metric's inverse); zero where the metric degenerates.
 fn tangent_params(g: &DiffGeom, d: &SurfaceDerivs, dir: &Vector3) -> [f64; 2] {
@@ -224,11 +259,29 @@ pub fn slices(
     let r = opts.tool_radius_mm;
     let h = side_scallop(opts);
     let spacing = deform::flat_spacing(r, h);
-    let mesh = ClMesh::new(model, r, opts.chordal_mm)?;
+    let form = if opts.isoplanar_shear {
+        RatioForm::Shear
+    } else {
+        RatioForm::ExactPlane
+    };
+    let frame = Frame::new(opts.slice_angle_deg);
+    // With the deformation, the ratio at every vertex of the mesh, from its exact normal and
+    // the curvature across the plane through it, and how much denser the curvature asks
+    // for: `(ratio, need)`, from the derivatives the mesh is made from.
+    let mut at_vertex: Vec<Option<(f64, f64)>> = Vec::new();
+    let mesh = if opts.isoplanar_deform {
+        ClMesh::new_with(model, r, opts.chordal_mm, &mut |k, d| {
+            if at_vertex.len() <= k {
+                at_vertex.resize(k + 1, None);
+            }
+            at_vertex[k] = vertex_ratio(model, &frame, form, r, d);
+        })?
+    } else {
+        ClMesh::new(model, r, opts.chordal_mm)?
+    };
     if !progress(0.2) {
         return Err(Error::Cancelled);
     }
-    let frame = Frame::new(opts.slice_angle_deg);
     let coords: Vec<[f64; 3]> = mesh
         .vertices
         .iter()
@@ -240,38 +293,14 @@ pub fn slices(
         x_hi = x_hi.max(c[0]);
     }
     let deformation = if opts.isoplanar_deform {
-        let form = if opts.isoplanar_shear {
-            RatioForm::Shear
-        } else {
-            RatioForm::ExactPlane
-        };
-        // The ratio at every vertex of the mesh, from its exact normal and the curvature
-        // across the plane through it; and how much denser the curvature asks for.
         let mut intervals = Vec::with_capacity(4 * mesh.vertices.len());
         let mut need = vec![1.0; mesh.vertices.len()];
         for (k, (v, c)) in mesh.vertices.iter().zip(&coords).enumerate() {
-            let Some(v) = v else { continue };
-            let Some((d, g)) = geometry(model, v.patch, v.uv) else {
+            let (Some(_), Some(&Some((ratio, n)))) = (v, at_vertex.get(k)) else {
                 continue;
             };
-            let n = [g.normal.dot(&frame.x), g.normal.dot(&frame.y), g.normal.z];
-            // Slopes of the CL surface (its normal is the design surface's at the contact),
-            // from +Z or, on an underside, from −Z: the plane spacing depends only on how
-            // steeply the surface climbs in x.
-            let (p, q) = if n[2].abs() > 0.0 {
-                (-n[0] / n[2], -n[1] / n[2])
-            } else {
-                (f64::INFINITY, 0.0)
-            };
-            let (kx, ky) = match feed_frame(&g.normal, &frame.x) {
-                Some((t, across)) => (
-                    curvature_along(&g, &d, &across),
-                    curvature_along(&g, &d, &t),
-                ),
-                None => (0.0, 0.0),
-            };
-            need[k] = deform::curvature_factor(r, kx);
-            intervals.push((c[0], c[0], deform::ratio(form, p, q, r, kx, ky)));
+            need[k] = n;
+            intervals.push((c[0], c[0], ratio));
         }
         // The edges as secants: their length across the planes (along the surface gradient
         // of x at their middle) over their extent in x, times the curvature's need.
