@@ -1774,11 +1774,11 @@ export class TspathPlanner extends HTMLElement {
       plan.report = v.report;
       this.dataset.status = v.report.status;
       this.dataset.verify = 'done';
-      // From Plan to this final heat map, the first simulation of a plan only (tests and
-      // the timing script read it).
-      if (plan.startedAt !== this.lastFinalOf) {
+      // From Plan to this final heat map, the first simulation of a plan only (the tests
+      // read it; for a strategy picked from the comparison, from when its planning began).
+      if (!plan.finalTimed) {
+        plan.finalTimed = true;
         this.dataset.planToFinalMs = String(Math.round(performance.now() - plan.startedAt));
-        this.lastFinalOf = plan.startedAt;
       }
       this.$('colour-heat').disabled = false;
       this.#showStats();
@@ -1803,6 +1803,7 @@ export class TspathPlanner extends HTMLElement {
 
   #clearPlan() {
     this.plan = null;
+    delete this.dataset.planToFinalMs;
     this.#stopPlay();
     if (this.view) {
       this.view.setPath(null);

@@ -35,10 +35,11 @@ use serde::{Deserialize, Serialize};
 const S_PER_MIN: f64 = 60.0;
 /// A move shorter than this in joint space (mm, or degrees for a turn) takes no time.
 const NULL_MOVE: f64 = 1e-12;
-/// Most steps of the speed searches (each narrows the interval the speed lies in; a
+/// Most steps of the peak-speed search (each narrows the interval the speed lies in; a
 /// bisection step halves it).
-const BISECTION_STEPS: usize = 60;
-/// The peak speed search stops when the interval it lies in is this share of its top.
+const PEAK_STEPS: usize = 60;
+/// The peak speed search stops when the interval it lies in, or Newton's step, is this
+/// share of its top or of where it stands.
 const SPEED_REL_TOL: f64 = 1e-11;
 /// Most Newton steps of [`reach`]'s cubic (it converges in a few from its start; from a
 /// start far above a tiny root each step shrinks the root's bracket by at least a third).
@@ -257,12 +258,18 @@ fn move_time(m: &Profile, v0: f64, v1: f64) -> f64 {
     // there (a move that only speeds up), so the search runs on `s = sqrt(v − base)`,
     // where `g` is smooth: Newton's method inside the bracket `[lo, hi]` of `s` (a
     // bisection step wherever Newton's would leave it), until the bracket or Newton's step
-    // is a few rounding steps wide.
+    // is within SPEED_REL_TOL of where it stands (of `s`, not the bracket: the root may lie
+    // near 0, on a short move between near-equal speeds). `g` is convex in `s`, so Newton's steps
+    // from the top stay above the root.
     let base = v0.max(v1);
     let g = |v: f64| change(v0, v, m.accel, m.jerk).1 + change(v, v1, m.accel, m.jerk).1 - m.p;
-    let (mut lo, mut hi) = (0.0, (m.top - base).sqrt());
+    let (mut lo, mut hi) = (0.0, (m.top - base).max(0.0).sqrt());
     let mut s = hi;
-    for _ in 0..BISECTION_STEPS {
+    // Where the steps run out, the top of the bracket (above the root: a slight overestimate
+    // of the time, never a peak at `base` that the move cannot hold).
+    let mut found = false;
+    let mut end = hi;
+    for _ in 0..PEAK_STEPS {
         let v = base + s * s;
         let gv = g(v);
         if gv <= 0.0 {
@@ -271,15 +278,18 @@ fn move_time(m: &Profile, v0: f64, v1: f64) -> f64 {
             hi = s;
         }
         if hi - lo <= SPEED_REL_TOL * hi {
+            end = lo;
+            found = true;
             break;
         }
         let slope = 2.0
             * s
             * (distance_slope(v0, v, m.accel, m.jerk) + distance_slope(v1, v, m.accel, m.jerk));
         let newton = s - gv / slope;
-        if (newton - s).abs() <= SPEED_REL_TOL * hi {
-            // Within rounding of the root: the lower of the two.
-            lo = lo.max(newton.min(s));
+        if (newton - s).abs() <= SPEED_REL_TOL * s {
+            // Converged (to just above the root, as `g` is convex).
+            end = newton.min(s);
+            found = true;
             break;
         }
         s = if newton > lo && newton < hi {
@@ -288,7 +298,39 @@ fn move_time(m: &Profile, v0: f64, v1: f64) -> f64 {
             0.5 * (lo + hi)
         };
     }
-    let peak = base + lo * lo;
+    // The time below is exact at a peak where `g <= 0` (the rest of the move at the peak
+    // speed); above the root the speed change alone overruns the move, and where the slope
+    // is steep (a short move between near-equal speeds) one rounding step of `v` overruns
+    // it by a share of 1e-5. So an end above the root steps down by growing multiples of
+    // its rounding step until below it, and the last steps are a bisection on `v` itself.
+    let (mut below, mut peak) = (
+        base + lo * lo,
+        base + if found { end * end } else { hi * hi },
+    );
+    if g(peak) > 0.0 {
+        let mut step = f64::EPSILON * peak;
+        for _ in 0..PEAK_STEPS {
+            let c = (peak - step).max(below);
+            if c <= below || g(c) <= 0.0 {
+                below = c;
+                break;
+            }
+            peak = c;
+            step *= 4.0;
+        }
+        for _ in 0..PEAK_STEPS {
+            let mid = 0.5 * (below + peak);
+            if mid <= below || mid >= peak {
+                break;
+            }
+            if g(mid) <= 0.0 {
+                below = mid;
+            } else {
+                peak = mid;
+            }
+        }
+        peak = below;
+    }
     let (ta, da) = change(v0, peak, m.accel, m.jerk);
     let (td, dd) = change(peak, v1, m.accel, m.jerk);
     // What the search leaves of the move, at the peak speed.
@@ -436,6 +478,83 @@ pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> Pat
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`move_time`]'s peak speed by plain bisection on `v` (the search before Newton's):
+    /// the second method.
+    fn move_time_by_bisection(m: &Profile, v0: f64, v1: f64) -> f64 {
+        let (ta, da) = change(v0, m.top, m.accel, m.jerk);
+        let (td, dd) = change(m.top, v1, m.accel, m.jerk);
+        if da + dd <= m.p {
+            return ta + td + (m.p - da - dd) / m.top;
+        }
+        let (mut lo, mut hi) = (v0.max(v1), m.top);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            let d = change(v0, mid, m.accel, m.jerk).1 + change(mid, v1, m.accel, m.jerk).1;
+            if d <= m.p {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let (ta, da) = change(v0, lo, m.accel, m.jerk);
+        let (td, dd) = change(lo, v1, m.accel, m.jerk);
+        ta + td + (m.p - da - dd).max(0.0) / lo.max(f64::MIN_POSITIVE)
+    }
+
+    #[test]
+    fn move_time_equals_bisection_in_every_regime() {
+        let mut next = crate::testing::uniform(0x9e37_79b9_7f4a_7c15);
+        let mut newton_cases = 0;
+        for case in 0..20_000 {
+            // Top speeds 1–100 mm/s, lengths 1e-6–10 mm, accelerations 10–5000 mm/s², jerks
+            // 100–1e6 mm/s³ or none; end speeds at rest, equal, or anywhere below the top
+            // that the move can join (the planner only asks for such).
+            let top = 1.0 + 99.0 * next();
+            let p = 10f64.powf(-6.0 + 7.0 * next());
+            let accel = 10f64.powf(1.0 + 2.7 * next());
+            let jerk = if case % 4 == 0 {
+                f64::INFINITY
+            } else {
+                10f64.powf(2.0 + 4.0 * next())
+            };
+            let v0 = match case % 3 {
+                0 => 0.0,
+                _ => top * next(),
+            };
+            let v1 = match case % 5 {
+                0 => 0.0,
+                1 => v0,
+                _ => reach(v0, p, top * next(), accel, jerk),
+            };
+            let v0 = v0.min(reach(v1, p, top, accel, jerk));
+            let m = Profile {
+                p,
+                top,
+                accel,
+                jerk,
+                to_path: 1.0,
+                dir: None,
+                rapid: false,
+                turn_only: false,
+            };
+            let (got, want) = (move_time(&m, v0, v1), move_time_by_bisection(&m, v0, v1));
+            if change(v0, top, accel, jerk).1 + change(top, v1, accel, jerk).1 > p {
+                newton_cases += 1;
+            }
+            assert!(
+                got.is_finite() && (got - want).abs() <= 1e-9 * want,
+                "case {case}: {got} s, bisection {want} s (v0 {v0}, v1 {v1}, top {top}, p {p}, a {accel}, j {jerk})"
+            );
+        }
+        assert!(
+            newton_cases > 5_000,
+            "{newton_cases} moves below their top speed"
+        );
+    }
 
     /// [`reach`] by bisection on [`change`]'s distance: the second method.
     fn reach_by_bisection(from: f64, p: f64, cap: f64, accel: f64, jerk: f64) -> f64 {

@@ -824,6 +824,7 @@ fn too_wide(
         points: Vec<(Point3, Point3, f64, Vector3)>,
         segments: Vec<(Point3, Point3)>,
     }
+    debug_assert_eq!(passes.len(), checks.len(), "a pass without its checks");
     let mut planes: Vec<Plane> = Vec::new();
     let n_passes = passes.len().max(1) as f64;
     for (k, (p, check)) in passes.iter().zip(checks).enumerate() {
@@ -1162,9 +1163,11 @@ impl Emit<'_> {
     }
 
     /// `points` without those the chords of their neighbours already hold: from each point
-    /// kept, the next kept is the farthest one whose chord passes within the limits of every
-    /// point between (the slice points lie as densely as the mesh's edges, far denser than
-    /// the chordal tolerance asks for on gently curved stretches).
+    /// kept, the next kept is one whose chord passes within the limits of every point
+    /// between while the next one's does not, found by doubling then halving: the farthest
+    /// such point wherever holding does not come back farther on. The slice points lie as
+    /// densely as the mesh's edges, far denser than the chordal tolerance asks for on gently
+    /// curved stretches.
     fn thin(&self, points: Vec<SurfacePoint>) -> Result<Vec<SurfacePoint>> {
         let n = points.len();
         if n < 3 {
