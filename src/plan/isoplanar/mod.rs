@@ -168,15 +168,18 @@ pub fn side_scallop(opts: &PlanOptions) -> f64 {
 fn geometry(model: &Model, patch: u32, uv: [f64; 2]) -> Option<(SurfaceDerivs, DiffGeom)> {
     let p = &model.layout.patches[patch as usize];
     let d = p.derivs(&model.surface, uv[0], uv[1]);
-    let g = DiffGeom::try_from_derivs(&d)?;
-    Some((
-        d,
-        if model.tool_side() < 0.0 {
-            g.flipped()
-        } else {
-            g
-        },
-    ))
+    let g = tool_side_geom(model, &d)?;
+    Some((d, g))
+}
+
+/// The fundamental forms of derivatives `d` of `model`, seen from the tool's side.
+fn tool_side_geom(model: &Model, d: &SurfaceDerivs) -> Option<DiffGeom> {
+    let g = DiffGeom::try_from_derivs(d)?;
+    Some(if model.tool_side() < 0.0 {
+        g.flipped()
+    } else {
+        g
+    })
 }
 
 /// The deformation ratio at a CL-mesh vertex whose contact point has patch derivatives `d`
@@ -189,12 +192,7 @@ fn vertex_ratio(
     r: f64,
     d: &SurfaceDerivs,
 ) -> Option<(f64, f64)> {
-    let g = DiffGeom::try_from_derivs(d)?;
-    let g = if model.tool_side() < 0.0 {
-        g.flipped()
-    } else {
-        g
-    };
+    let g = tool_side_geom(model, d)?;
     let n = [g.normal.dot(&frame.x), g.normal.dot(&frame.y), g.normal.z];
     // Slopes of the CL surface (its normal is the design surface's at the contact), from +Z
     // or, on an underside, from −Z: the plane spacing depends only on how steeply the
@@ -270,11 +268,10 @@ pub fn slices(
     // for: `(ratio, need)`, from the derivatives the mesh is made from.
     let mut at_vertex: Vec<Option<(f64, f64)>> = Vec::new();
     let mesh = if opts.isoplanar_deform {
+        // The mesh hands over its vertices in order.
         ClMesh::new_with(model, r, opts.chordal_mm, &mut |k, d| {
-            if at_vertex.len() <= k {
-                at_vertex.resize(k + 1, None);
-            }
-            at_vertex[k] = vertex_ratio(model, &frame, form, r, d);
+            debug_assert_eq!(k, at_vertex.len(), "vertices in order");
+            at_vertex.push(vertex_ratio(model, &frame, form, r, d));
         })?
     } else {
         ClMesh::new(model, r, opts.chordal_mm)?
