@@ -481,12 +481,12 @@ fn first_derivatives_alone_equal_the_full_evaluation_bit_for_bit() {
 }
 
 #[test]
-fn grid_evaluation_equals_point_by_point_bit_for_bit() {
+fn grid_and_line_evaluation_equal_point_by_point_bit_for_bit() {
     // Model::smallest_concave_radius and tool_side evaluate whole grids per face at once
     // (issue 20: the summary of a 10 000-face cage); the numbers must be derivs' own, on
     // T-spline cells, subdivision leaves (measured from an origin) and deeper trees.
     let ts = [0.0, 1e-3, 0.2, 0.5, 0.77, 0.999, 1.0];
-    let mut single = 0;
+    let (mut single, mut lines, mut multi_cell) = (0, 0, 0);
     for s in SAMPLES {
         let m = samples::load_sample(s.name).unwrap();
         for f in m.surface.faces() {
@@ -501,7 +501,27 @@ fn grid_evaluation_equals_point_by_point_bit_for_bit() {
                 seen += 1;
             });
             assert_eq!(seen, ts.len() * ts.len());
+            // Lines u = const (the cutting simulation's columns): through every Bézier cell
+            // and across its breaks, forwards and back (the line keeps one cell's rows).
+            let (ub, vb) = f.breaks();
+            let mut vs: Vec<f64> = ts.iter().chain(vb).copied().collect();
+            vs.extend(vb.iter().map(|b| (b - 1e-9).max(0.0)));
+            let back: Vec<f64> = vs.iter().rev().copied().collect();
+            vs.extend(back);
+            for &u in ts.iter().chain(ub) {
+                let mut line = f.u_line(u);
+                for &v in &vs {
+                    lines += 1;
+                    multi_cell += (ub.len() > 2 || vb.len() > 2) as usize;
+                    assert_eq!(line.derivs(v), f.derivs(u, v), "{} at ({u}, {v})", s.name);
+                }
+            }
         }
     }
     assert!(single > 100, "{single} one-leaf faces checked");
+    assert!(
+        multi_cell > 1000,
+        "{multi_cell} points on faces of several cells"
+    );
+    assert!(lines > 10_000, "{lines} points along lines");
 }

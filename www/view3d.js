@@ -178,20 +178,38 @@ export class View3D {
     const { indices: idx, patchIds } = this.model;
     const col = this.surface.geometry.getAttribute('color');
     const c = new THREE.Color();
+    // Each colour converted to the renderer's space once (a few dozen colours, a million
+    // corners on a fine tessellation).
+    const linear = new Map();
+    const rgb = (hex) => {
+      let v = linear.get(hex);
+      if (!v) {
+        c.setHex(hex);
+        v = [c.r, c.g, c.b];
+        linear.set(hex, v);
+      }
+      return v;
+    };
+    const a = col.array;
     for (let corner = 0; corner < idx.length; corner++) {
       const hex = this.heat
         ? heatColour(this.heat.values[idx[corner]], this.heat.scallopMm)
         : PATCH_COLOURS[patchIds[(corner / 3) | 0] % PATCH_COLOURS.length];
-      c.setHex(hex);
-      col.setXYZ(corner, c.r, c.g, c.b);
+      const [r, g, b] = rgb(hex);
+      a[3 * corner] = r;
+      a[3 * corner + 1] = g;
+      a[3 * corner + 2] = b;
     }
     col.needsUpdate = true;
+    this.colouredBy = this.heat;
     this.render();
   }
 
   /** The scallop heat map (one value per tessellation vertex, mm) or null for patches. */
   setHeat(values, scallopMm) {
     this.heat = values ? { values, scallopMm } : null;
+    // Patch colours already shown: nothing to do (each plan clears the heat map twice).
+    if (!this.heat && this.colouredBy === null) return;
     this.#colourSurface();
   }
 

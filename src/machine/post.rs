@@ -219,6 +219,8 @@ pub struct Posted {
     pub text: String,
     /// What each motion block in program order is.
     pub sources: Vec<Source>,
+    /// The 1-based line of each motion block in `text` (beside `sources`).
+    pub lines: Vec<usize>,
     /// Blocks inserted to keep joint-space motion on the planned chords.
     pub inserted: usize,
     /// Joint values of every path move.
@@ -295,10 +297,16 @@ struct Out {
     text: String,
     block: usize,
     sources: Vec<Source>,
+    /// Lines written so far.
+    written: usize,
+    /// The line of each motion block (beside `sources`).
+    lines: Vec<usize>,
 }
 
 impl Out {
     fn line(&mut self, s: &str) {
+        debug_assert!(!s.contains('\n'), "one line at a time: {s:?}");
+        self.written += 1;
         if self.syntax == Syntax::Heidenhain {
             let _ = writeln!(self.text, "{} {s}", self.block);
             self.block += 1;
@@ -379,6 +387,7 @@ impl Out {
         }
         self.line(&words.join(" "));
         self.sources.push(m.source);
+        self.lines.push(self.written);
     }
 }
 
@@ -482,6 +491,8 @@ pub fn post_program(
         text: String::new(),
         block: 0,
         sources: Vec::new(),
+        written: 0,
+        lines: Vec::new(),
     };
     let pname = program_name(&job.model);
     let unit_word = match units {
@@ -822,6 +833,7 @@ pub fn post_program(
     Ok(Posted {
         text: o.text,
         sources: o.sources,
+        lines: o.lines,
         inserted,
         joints,
         mode,

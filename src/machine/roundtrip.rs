@@ -136,6 +136,20 @@ pub fn compare(
             posted.sources.len()
         )));
     }
+    // The post's record of where each block is (the page highlights by it) against the
+    // reader's count of lines.
+    if let Some((k, (line, block))) = posted
+        .lines
+        .iter()
+        .zip(&program.moves)
+        .enumerate()
+        .find(|(_, (&line, block))| line != block.line)
+    {
+        return Err(mismatch(format!(
+            "motion block {k} reads back at line {}, the post recorded line {line}",
+            block.line
+        )));
+    }
     let poses = tool_poses(program, machine, dialect);
     let r = path.tool_radius_mm;
     let mut out = RoundTrip {

@@ -175,7 +175,7 @@ impl BezierPatch {
 
     /// The rows contracted along `u`: value, d/du and d²/du² of each row `j`.
     #[inline]
-    fn rows_at(&self, u: f64) -> [[Vector4; 4]; 3] {
+    pub(crate) fn rows_at(&self, u: f64) -> Rows {
         let (bu, dbu, ddbu) = bernstein3(u);
         let mut r0 = [Vector4::zeros(); 4];
         let mut r1 = [Vector4::zeros(); 4];
@@ -191,8 +191,10 @@ impl BezierPatch {
         [r0, r1, r2]
     }
 
+    /// Point and derivatives at `v` from the rows of [`BezierPatch::rows_at`]`(u)`: those of
+    /// `(u, v)`.
     #[inline]
-    fn finish_derivs(rows: &[[Vector4; 4]; 3], v: f64) -> SurfaceDerivs {
+    pub(crate) fn finish_derivs(rows: &Rows, v: f64) -> SurfaceDerivs {
         let [r0, r1, r2] = rows;
         let (bv, dbv, ddbv) = bernstein3(v);
         let mut a = Vector4::zeros();
@@ -212,6 +214,9 @@ impl BezierPatch {
         rational_derivs(a, au, av, auu, auv, avv)
     }
 }
+
+/// A patch contracted along `u` ([`BezierPatch::rows_at`]).
+pub(crate) type Rows = [[Vector4; 4]; 3];
 
 /// Homogeneous weights at most this fraction of a cell's largest weight count as zero
 /// (relative, dimensionless); exact zeros arise where every blending function vanishes.

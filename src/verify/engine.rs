@@ -206,9 +206,13 @@ fn grids(surface: &Surface, samples: usize) -> Vec<FaceGrid> {
         .collect()
 }
 
-/// Derivatives with a usable normal: at `(u, v)`, else nudged towards the middle.
-fn geometry(face: &FaceSurface, u: f64, v: f64) -> Option<(SurfaceDerivs, DiffGeom)> {
-    let d = face.derivs(u, v);
+/// Derivatives with a usable normal: `d`, those at `(u, v)`, else nudged towards the middle.
+fn geometry(
+    face: &FaceSurface,
+    d: SurfaceDerivs,
+    u: f64,
+    v: f64,
+) -> Option<(SurfaceDerivs, DiffGeom)> {
     if let Some(g) = DiffGeom::try_from_derivs(&d) {
         return Some((d, g));
     }
@@ -229,6 +233,19 @@ fn geometry(face: &FaceSurface, u: f64, v: f64) -> Option<(SurfaceDerivs, DiffGe
 }
 
 fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
+    let d = ctx.surface.faces()[fi].derivs(u, v);
+    measure_with(ctx, probe, fi, u, v, d)
+}
+
+/// As [`measure`], with the surface's derivatives at `(u, v)` given.
+fn measure_with(
+    ctx: &Ctx,
+    probe: &mut Probe,
+    fi: usize,
+    u: f64,
+    v: f64,
+    d: SurfaceDerivs,
+) -> Sample {
     let face = &ctx.surface.faces()[fi];
     let rest = ctx.rest.contains(fi, u, v);
     let unmeasured = |point: Point3, singular: bool, area_density: f64| Sample {
@@ -249,7 +266,7 @@ fn measure(ctx: &Ctx, probe: &mut Probe, fi: usize, u: f64, v: f64) -> Sample {
         area_density,
         rest,
     };
-    let Some((d, g)) = geometry(face, u, v) else {
+    let Some((d, g)) = geometry(face, d, u, v) else {
         return unmeasured(face.subs(u, v), true, 0.0);
     };
     let area_density = d.su.cross(&d.sv).norm();
@@ -353,11 +370,14 @@ fn band(
     let mut row: Vec<Sample> = Vec::with_capacity(nu);
     // Grid coordinates by division, so that the last row and column are exactly 1.
     let at = |k: usize, n: usize| k as f64 / (n - 1) as f64;
+    // The band's columns: each contracted along u once per Bézier cell.
+    let face = &ctx.surface.faces()[fi];
+    let mut columns: Vec<_> = (0..nu).map(|i| face.u_line(at(i, nu))).collect();
     for j in j0..=j1 {
         let v = at(j, nv);
         row.clear();
-        for i in 0..nu {
-            row.push(measure(ctx, probe, fi, at(i, nu), v));
+        for (i, column) in columns.iter_mut().enumerate() {
+            row.push(measure_with(ctx, probe, fi, at(i, nu), v, column.derivs(v)));
         }
         if j > j0 || own_first {
             let wv = if j == 0 || j == nv - 1 { 0.5 } else { 1.0 };
@@ -682,7 +702,7 @@ fn vote_side(ctx: &Ctx, probe: &mut Probe) -> f64 {
                     (i as f64 + 0.5) / SIDE_PROBE as f64,
                     (j as f64 + 0.5) / SIDE_PROBE as f64,
                 );
-                let Some((d, g)) = geometry(face, u, v) else {
+                let Some((d, g)) = geometry(face, face.derivs(u, v), u, v) else {
                     continue;
                 };
                 if let Some(c) = probe.nearest_centre(&d.point, &g.normal, 2.0 * ctx.radius) {

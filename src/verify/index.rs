@@ -2,7 +2,9 @@
 //! that may reach into it: those whose segment passes within the tool radius plus the
 //! cell's half-diagonal of the cell's centre. A query walks the cells a line segment passes
 //! through (3D DDA); every capsule the segment meets is listed in one of them, and one met
-//! in several cells is reported once per query.
+//! in several cells is reported once per query. Before a listed capsule is reported, its
+//! bounding ball is tested against the segment's (a few operations): most capsules of a cell
+//! lie too far from a short query segment, and this test drops them before the exact one.
 
 use super::capsule::Capsule;
 use crate::geom::{Aabb, Point3};
@@ -21,6 +23,13 @@ pub struct CapsuleIndex {
     /// `starts[c]..starts[c + 1]` indexes `items` for cell `c`.
     starts: Vec<u32>,
     items: Vec<u32>,
+    /// Per capsule: the middle of its move and the radius of the ball around that middle
+    /// holding the whole capsule (mm: tool radius plus half the move, with the slack).
+    balls: Vec<[f64; 4]>,
+    /// Per capsule: start, unit direction and length of its move (mm).
+    axes: Vec<[f64; 7]>,
+    /// The tool radius with the slack (mm).
+    radius_slack: f64,
 }
 
 impl CapsuleIndex {
@@ -40,6 +49,21 @@ impl CapsuleIndex {
             dims,
             starts: Vec::new(),
             items: Vec::new(),
+            balls: capsules
+                .iter()
+                .map(|c| {
+                    let m = c.start + c.dir * (0.5 * c.len);
+                    [m.x, m.y, m.z, (radius + 0.5 * c.len) * (1.0 + SLACK)]
+                })
+                .collect(),
+            axes: capsules
+                .iter()
+                .map(|c| {
+                    let (a, d) = (c.start, c.dir);
+                    [a.x, a.y, a.z, d.x, d.y, d.z, c.len]
+                })
+                .collect(),
+            radius_slack: radius * (1.0 + SLACK),
         };
         let ncells = dims[0] * dims[1] * dims[2];
         // A capsule meeting a point of a cell comes within r + half-diagonal of its centre;
@@ -125,8 +149,10 @@ impl CapsuleIndex {
         }
     }
 
-    /// Calls `f` with every capsule listed in a cell the segment `a`–`b` passes through;
-    /// `seen[i] == stamp` marks capsule `i` as already reported in this query.
+    /// Calls `f` with every capsule listed in a cell the segment `a`–`b` passes through
+    /// whose bounding ball comes within the segment's half-length of its middle (every
+    /// capsule the segment meets among them); `seen[i] == stamp` marks capsule `i` as
+    /// already reported in this query.
     pub fn visit(
         &self,
         a: &Point3,
@@ -135,7 +161,9 @@ impl CapsuleIndex {
         stamp: u32,
         mut f: impl FnMut(u32),
     ) {
-        let mut emit = |cell: usize| self.emit_new(cell, seen, stamp, &mut f);
+        let mid = [0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)];
+        let half = 0.5 * (b - a).norm() * (1.0 + SLACK);
+        let mut emit = |cell: usize| self.emit_near(cell, &mid, half, seen, stamp, &mut f);
         // Clip the segment to the grid's box (slabs).
         let d = b - a;
         let (mut t0, mut t1) = (0.0f64, 1.0f64);
@@ -236,6 +264,43 @@ impl CapsuleIndex {
     fn emit_new(&self, cell: usize, seen: &mut [u32], stamp: u32, f: &mut impl FnMut(u32)) {
         let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
         for &i in &self.items[s..e] {
+            if seen[i as usize] != stamp {
+                seen[i as usize] = stamp;
+                f(i);
+            }
+        }
+    }
+
+    /// As [`CapsuleIndex::emit_new`], for the capsules of `cell` whose bounding ball comes
+    /// within `half` of `mid` only; the others are neither reported nor marked (a second
+    /// cell listing one tests it again, with the same answer).
+    #[inline]
+    fn emit_near(
+        &self,
+        cell: usize,
+        mid: &[f64; 3],
+        half: f64,
+        seen: &mut [u32],
+        stamp: u32,
+        f: &mut impl FnMut(u32),
+    ) {
+        let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
+        for &i in &self.items[s..e] {
+            let b = &self.balls[i as usize];
+            let (dx, dy, dz) = (b[0] - mid[0], b[1] - mid[1], b[2] - mid[2]);
+            let within = b[3] + half;
+            if dx * dx + dy * dy + dz * dz > within * within {
+                continue;
+            }
+            // Closer: the move's segment from the query's middle.
+            let ax = &self.axes[i as usize];
+            let (wx, wy, wz) = (mid[0] - ax[0], mid[1] - ax[1], mid[2] - ax[2]);
+            let s = (wx * ax[3] + wy * ax[4] + wz * ax[5]).clamp(0.0, ax[6]);
+            let (ex, ey, ez) = (wx - s * ax[3], wy - s * ax[4], wz - s * ax[5]);
+            let reach = self.radius_slack + half;
+            if ex * ex + ey * ey + ez * ez > reach * reach {
+                continue;
+            }
             if seen[i as usize] != stamp {
                 seen[i as usize] = stamp;
                 f(i);

@@ -685,10 +685,9 @@ impl WasmPlan {
     }
 
     /// For each move, the 1-based line of the program `gcodeFor(machine, dialect, units)`
-    /// returns that ends at it (for highlighting the block beside a scrubbed tool). The lines
-    /// come from reading that program back with the machine module's reader, matched to
-    /// moves through the post's record of which move each motion block is; a move the post
-    /// wrote no block for gets the line of the block before it.
+    /// returns that ends at it (for highlighting the block beside a scrubbed tool): the post
+    /// records the line of each motion block it writes and which move that block is; a move
+    /// the post wrote no block for gets the line of the block before it.
     #[wasm_bindgen(js_name = gcodeLines)]
     pub fn gcode_lines(
         &self,
@@ -701,24 +700,16 @@ impl WasmPlan {
         let u = Units::parse(units).map_err(js_err)?;
         let posted = machine::post::post_program(&self.path, &self.opts, &self.job, &m, d, u)
             .map_err(js_err)?;
-        let program = machine::reader::read(&posted.text).map_err(js_err)?;
-        let key = [machine, dialect, units].map(str::to_string);
-        *self.posted.borrow_mut() = Some((key, posted.text.clone()));
-        if program.moves.len() != posted.sources.len() {
-            return Err(JsError::new(&format!(
-                "the program reads back {} motion blocks, the post wrote {}",
-                program.moves.len(),
-                posted.sources.len()
-            )));
-        }
         let mut lines = vec![0u32; self.path.moves.len()];
-        for (src, block) in posted.sources.iter().zip(&program.moves) {
+        for (src, &line) in posted.sources.iter().zip(&posted.lines) {
             if let machine::post::Source::Move(i) = *src {
                 if let Some(l) = lines.get_mut(i) {
-                    *l = block.line as u32;
+                    *l = line as u32;
                 }
             }
         }
+        let key = [machine, dialect, units].map(str::to_string);
+        *self.posted.borrow_mut() = Some((key, posted.text));
         let mut last = 0;
         for l in lines.iter_mut() {
             if *l == 0 {
