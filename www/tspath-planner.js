@@ -1313,20 +1313,21 @@ export class TspathPlanner extends HTMLElement {
     this.dataset.status = result.report.status;
     this.dataset.verify = 'pending';
     this.#planStatus();
-    await this.#post();
+    // From Plan to the plan shown: what "re-plan when fast" goes by (not the program).
     this.lastPlanMs = performance.now() - t0;
+    const again = this.replanAfter && !this.#planMatches();
+    this.replanAfter = false;
+    // The program is asked for first and the simulation right behind it, so that the
+    // worker goes on from the one to the other without waiting for the page.
+    const posted = this.#post();
+    if (!again) this.#verify();
+    await posted;
     this.dataset.plans = String(Number(this.dataset.plans || 0) + 1);
     // Where the slider is: 0 for a new plan, unless it was moved while the program was
     // being written.
     this.#scrubTo(Number(this.$('scrub').value));
     this.#syncUrl();
-    const again = this.replanAfter && !this.#planMatches();
-    this.replanAfter = false;
-    if (again) {
-      this.#plan();
-      return;
-    }
-    this.#verify();
+    if (again) this.#plan();
   }
 
   // ---------------------------------------------------------------- comparison
@@ -1638,6 +1639,9 @@ export class TspathPlanner extends HTMLElement {
         this.#showColours();
       }
       if (!quiet) this.#status('Simulation cancelled.');
+      // The program was being written behind the simulation's request: write it again in
+      // the new worker.
+      if (this.posting && this.plan && !quiet) this.#post();
     }
     this.dataset.cancelMs = String(Math.round(performance.now() - t0));
   }
@@ -1757,7 +1761,10 @@ export class TspathPlanner extends HTMLElement {
       if (!this.planning) bar.hidden = true;
     };
     try {
-      const v = await this.client.call('verify', [{ samples: start, bound_mm: bound, max_samples: cap }], (f) => {
+      // The side the tool works from, as the preview found it (the same vote: the final
+      // simulation need not take it again).
+      const side = plan.preview ? { tool_side: plan.preview.summary.tool_side } : {};
+      const v = await this.client.call('verify', [{ samples: start, bound_mm: bound, max_samples: cap, ...side }], (f) => {
         if (token !== this.verifyToken || plan !== this.plan || this.planning) return;
         bar.hidden = false;
         bar.value = f;

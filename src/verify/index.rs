@@ -26,8 +26,6 @@ pub struct CapsuleIndex {
     /// Per capsule: the middle of its move and the radius of the ball around that middle
     /// holding the whole capsule (mm: tool radius plus half the move, with the slack).
     balls: Vec<[f64; 4]>,
-    /// Per capsule: start, unit direction and length of its move (mm).
-    axes: Vec<[f64; 7]>,
     /// The tool radius with the slack (mm).
     radius_slack: f64,
 }
@@ -54,13 +52,6 @@ impl CapsuleIndex {
                 .map(|c| {
                     let m = c.start + c.dir * (0.5 * c.len);
                     [m.x, m.y, m.z, (radius + 0.5 * c.len) * (1.0 + SLACK)]
-                })
-                .collect(),
-            axes: capsules
-                .iter()
-                .map(|c| {
-                    let (a, d) = (c.start, c.dir);
-                    [a.x, a.y, a.z, d.x, d.y, d.z, c.len]
                 })
                 .collect(),
             radius_slack: radius * (1.0 + SLACK),
@@ -150,11 +141,13 @@ impl CapsuleIndex {
     }
 
     /// Calls `f` with every capsule listed in a cell the segment `a`–`b` passes through
-    /// whose bounding ball comes within the segment's half-length of its middle (every
-    /// capsule the segment meets among them); `seen[i] == stamp` marks capsule `i` as
-    /// already reported in this query.
+    /// whose bounding ball, then whose move's segment, comes within the tool radius plus
+    /// the segment's half-length of its middle (every capsule the segment meets among
+    /// them); `capsules` are those the index was built from; `seen[i] == stamp` marks
+    /// capsule `i` as already reported in this query.
     pub fn visit(
         &self,
+        capsules: &[Capsule],
         a: &Point3,
         b: &Point3,
         seen: &mut [u32],
@@ -163,7 +156,8 @@ impl CapsuleIndex {
     ) {
         let mid = [0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)];
         let half = 0.5 * (b - a).norm() * (1.0 + SLACK);
-        let mut emit = |cell: usize| self.emit_near(cell, &mid, half, seen, stamp, &mut f);
+        let mut emit =
+            |cell: usize| self.emit_near(capsules, cell, &mid, half, seen, stamp, &mut f);
         // Clip the segment to the grid's box (slabs).
         let d = b - a;
         let (mut t0, mut t1) = (0.0f64, 1.0f64);
@@ -275,8 +269,10 @@ impl CapsuleIndex {
     /// within `half` of `mid` only; the others are neither reported nor marked (a second
     /// cell listing one tests it again, with the same answer).
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     fn emit_near(
         &self,
+        capsules: &[Capsule],
         cell: usize,
         mid: &[f64; 3],
         half: f64,
@@ -293,10 +289,11 @@ impl CapsuleIndex {
                 continue;
             }
             // Closer: the move's segment from the query's middle.
-            let ax = &self.axes[i as usize];
-            let (wx, wy, wz) = (mid[0] - ax[0], mid[1] - ax[1], mid[2] - ax[2]);
-            let s = (wx * ax[3] + wy * ax[4] + wz * ax[5]).clamp(0.0, ax[6]);
-            let (ex, ey, ez) = (wx - s * ax[3], wy - s * ax[4], wz - s * ax[5]);
+            let c = &capsules[i as usize];
+            let (a, d) = (&c.start, &c.dir);
+            let (wx, wy, wz) = (mid[0] - a.x, mid[1] - a.y, mid[2] - a.z);
+            let s = (wx * d.x + wy * d.y + wz * d.z).clamp(0.0, c.len);
+            let (ex, ey, ez) = (wx - s * d.x, wy - s * d.y, wz - s * d.z);
             let reach = self.radius_slack + half;
             if ex * ex + ey * ey + ez * ez > reach * reach {
                 continue;
@@ -344,7 +341,7 @@ mod tests {
                 let n = Vector3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize();
                 let (lo, hi) = (-2.0 * rnd(), 2.0 * rnd());
                 let mut visited = Vec::new();
-                index.visit(&(p + n * lo), &(p + n * hi), &mut seen, q, |i| {
+                index.visit(&capsules, &(p + n * lo), &(p + n * hi), &mut seen, q, |i| {
                     visited.push(i)
                 });
                 for (i, c) in capsules.iter().enumerate() {

@@ -456,6 +456,9 @@ fn bound_rounds(
     let mut o = opts.clone();
     o.samples = o.samples.max(first).min(cap);
     let mut v = run(&o, 0)?;
+    // The side the first round found (the vote does not depend on the samples): later
+    // rounds need not vote again.
+    o.tool_side = v.tool_side;
     for round in 1..BOUND_ROUNDS {
         if v.error_bound_mm <= target_mm || o.samples >= cap {
             break;

@@ -149,11 +149,12 @@ impl<'a> Probe<'a> {
         }
         self.next_stamp();
         let hits = &mut self.hits;
-        self.index.visit(&a, &b, &mut self.seen, self.stamp, |i| {
-            if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
-                hits.push((i, h));
-            }
-        });
+        self.index
+            .visit(caps, &a, &b, &mut self.seen, self.stamp, |i| {
+                if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
+                    hits.push((i, h));
+                }
+            });
     }
 
     /// The capsule nearest to `p` (distance from its segment) within `within` mm, and the
@@ -163,13 +164,14 @@ impl<'a> Probe<'a> {
         let (a, b) = (p - n * within, p + n * within);
         let caps = self.capsules;
         let mut best: Option<(f64, Point3)> = None;
-        self.index.visit(&a, &b, &mut self.seen, self.stamp, |i| {
-            let c = caps[i as usize].closest_on_axis(p);
-            let d = (c - p).norm();
-            if d <= within && best.is_none_or(|(bd, _)| d < bd) {
-                best = Some((d, c));
-            }
-        });
+        self.index
+            .visit(caps, &a, &b, &mut self.seen, self.stamp, |i| {
+                let c = caps[i as usize].closest_on_axis(p);
+                let d = (c - p).norm();
+                if d <= within && best.is_none_or(|(bd, _)| d < bd) {
+                    best = Some((d, c));
+                }
+            });
         best.map(|(_, c)| c)
     }
 
