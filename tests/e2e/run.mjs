@@ -592,7 +592,11 @@ test('a malformed file shows an error and the previous model stays usable', asyn
   // Dropped on the view: a cage whose face names a vertex that does not exist.
   const drop = (fileName, text) => dropFile(page, fileName, text);
   await drop('cage.obj', 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 9\n');
-  await page.waitForFunction(() => /cage\.obj/.test(document.querySelector('tspath-planner').shadowRoot.getElementById('status').textContent));
+  // The error, not the "Loading cage.obj…" before it (a busy machine shows that a frame).
+  await page.waitForFunction(() => {
+    const status = document.querySelector('tspath-planner').shadowRoot.getElementById('status');
+    return status.classList.contains('error') && /cage\.obj/.test(status.textContent);
+  });
   const dropMsg = await page.textContent('#status');
   check(/cage\.obj/.test(dropMsg) && /line 5/.test(dropMsg), `drop error should name the file and line: ${dropMsg}`);
   check(await attr(page, 'data-model') === 'keycap-convex', 'still the previous model');
