@@ -24,7 +24,7 @@ import {
 import { area, bytes, deg, int, minutes, mm, mmSig, ms, pct, share } from './format.js';
 import { GROUPS, PARAMS, byKey, flagOn, placement, planOptions, validate } from './params.js';
 
-/** Plans faster than this (ms, planning and posting) are redone on every change. */
+/** Plans faster than this (ms, from Plan to the path shown) are redone on every change. */
 const AUTO_REPLAN_MS = 1500;
 /** Pause after the last change before an automatic re-plan (ms). */
 const REPLAN_DELAY_MS = 300;
@@ -1317,11 +1317,13 @@ export class TspathPlanner extends HTMLElement {
     this.lastPlanMs = performance.now() - t0;
     const again = this.replanAfter && !this.#planMatches();
     this.replanAfter = false;
-    // The program is asked for first and the simulation right behind it, so that the
-    // worker goes on from the one to the other without waiting for the page.
-    const posted = this.#post();
-    if (!again) this.#verify();
-    await posted;
+    // The program first; the simulation is asked for as soon as the worker answers, before
+    // the page takes the program in, so the worker waits one message, not for the page. (Not
+    // both at once: a Cancel of the simulation would lose the program with the worker.)
+    const plan = this.plan;
+    await this.#post(() => {
+      if (!again && plan === this.plan && !this.planning) this.#verify();
+    });
     this.dataset.plans = String(Number(this.dataset.plans || 0) + 1);
     // Where the slider is: 0 for a new plan, unless it was moved while the program was
     // being written.
@@ -1639,9 +1641,6 @@ export class TspathPlanner extends HTMLElement {
         this.#showColours();
       }
       if (!quiet) this.#status('Simulation cancelled.');
-      // The program was being written behind the simulation's request: write it again in
-      // the new worker.
-      if (this.posting && this.plan && !quiet) this.#post();
     }
     this.dataset.cancelMs = String(Math.round(performance.now() - t0));
   }
@@ -1662,8 +1661,10 @@ export class TspathPlanner extends HTMLElement {
   }
 
   /** Writes the program of the plan for the machine, dialect and units shown (choices
-   * that are always valid, so a wrong number elsewhere does not hold the program back). */
-  async #post() {
+   * that are always valid, so a wrong number elsewhere does not hold the program back).
+   * `answered`: called when the worker has answered (or failed, not when cancelled), before
+   * the page takes the program in. */
+  async #post(answered = null) {
     if (!this.plan) return;
     const plan = this.plan;
     const [machine, dialect, units] = ['machine', 'dialect', 'units'].map((k) => this.$(`p-${k}`).value);
@@ -1671,7 +1672,10 @@ export class TspathPlanner extends HTMLElement {
     this.#updateDownloads();
     try {
       if (!(await this.#ensureWorkerPlan())) return;
-      const g = await this.client.call('post', [machine, dialect, units]);
+      const g = await this.client.call('post', [machine, dialect, units]).then(
+        (r) => { answered?.(); return r; },
+        (e) => { if (!(e instanceof CancelledError)) answered?.(); throw e; },
+      );
       if (plan !== this.plan) return;
       plan.gcode = { ...g, machine, dialect, units, lineStarts: null, lineCount: 0 };
       // The machining time on this machine (the simulation's report keeps its other keys).

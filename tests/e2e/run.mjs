@@ -1587,7 +1587,7 @@ test('a saved job reopens in a fresh browser to the same plan: the same G-code b
   return `job ${job.bytes.length} bytes; reopened in a fresh profile: G-code ${g2.length} bytes, equal; broken job: “${st.slice(0, 60)}…”`;
 });
 
-test('races: the tool and the listing follow the slider moved while the program is written; an error shown during the simulation stays', async (page, url) => {
+test('races: the tool and the listing follow the slider moved while the program is written; an error shown during the simulation stays; the program stays after a Cancel of the simulation or a failed load', async (page, url) => {
   await page.goto(`${url}?model=dome&scallop=0.05&${SIM}`);
   await waitState(page, 'model-loaded');
   await page.uncheck('#auto');
@@ -1620,7 +1620,33 @@ test('races: the tool and the listing follow the slider moved while the program 
   const st = await page.locator(`${HOST} >> #status`).textContent();
   const tone = await page.evaluate((h) => document.querySelector(h).shadowRoot.getElementById('status').className, HOST);
   check(st === err && /error/.test(tone), `the error stays after the simulation: “${st}” (was “${err}”)`);
-  return `slider at move ${to}: tool there, listing line ${after.line}; “${st.slice(0, 60)}…” stays`;
+  // Cancel of the simulation: the program stays written and the page is ready to plan.
+  await setParam(page, 'scallop', '0.05');
+  // (Right when the simulation starts, not after the plan is counted: the program is still
+  // being written then if both were asked for together.)
+  await page.click('#plan');
+  await page.waitForFunction((h) => document.querySelector(h).dataset.verify === 'running', HOST);
+  await page.click('#cancel');
+  const cancelled = await host(page, (el) => ({
+    verify: el.dataset.verify, status: el.shadowRoot.getElementById('status').textContent,
+    gcode: !el.shadowRoot.getElementById('download-gcode').disabled && !!el.plan.gcode,
+    plan: !el.shadowRoot.getElementById('plan').disabled,
+  }));
+  check(cancelled.verify === 'cancelled' && /Simulation cancelled/.test(cancelled.status) && cancelled.gcode && cancelled.plan,
+    `after Cancel of the simulation: ${JSON.stringify(cancelled)}`);
+  // A model that fails to load while the simulation runs (its load cancels the simulation):
+  // the plan shown keeps its program.
+  await page.click('#plan');
+  await page.waitForFunction((h) => document.querySelector(h).dataset.verify === 'running', HOST);
+  await host(page, (el) => { el.client.load = async () => { throw new Error('the test refuses this load'); }; });
+  await page.selectOption('#sample', 'keycap-convex');
+  await page.waitForFunction((h) => /refuses this load/.test(document.querySelector(h).shadowRoot.getElementById('status').textContent), HOST);
+  const kept = await host(page, (el) => ({
+    model: el.dataset.model, state: el.dataset.state,
+    gcode: !el.shadowRoot.getElementById('download-gcode').disabled && !!el.plan?.gcode,
+  }));
+  check(kept.model === 'dome' && kept.state === 'planned' && kept.gcode, `after a failed load during the simulation: ${JSON.stringify(kept)}`);
+  return `slider at move ${to}: tool there, listing line ${after.line}; “${st.slice(0, 60)}…” stays; the program stays after a Cancel of the simulation and after a failed load`;
 });
 
 test('stock and program zero: at the stock\'s top corner and at a typed point, as the CLI\'s --stock-side --stock-top --zero; the stock drawn', async (page, url) => {
