@@ -21,6 +21,10 @@
 //! maximum scallop lies in `[max_scallop_mm, max_scallop_mm + scallop_error_bound_mm]` and
 //! the true deepest gouge in `[max_gouge_mm, max_gouge_mm + gouge_error_bound_mm]`;
 //! `error_bound_mm` is the larger of the two. Both fall with the square of the spacing.
+//! A cell whose bound exceeds the highest material (or deepest gouge) measured so far by
+//! more than a share of the scallop is split and sampled again; a coarse pass (one sample
+//! in 16, no bounds) first measures a floor for those maxima, so that flat regions, whose
+//! own scallop is small, are not refined towards it.
 
 pub mod bound;
 pub mod capsule;
@@ -289,7 +293,8 @@ pub struct PatchVerification {
     pub error_bound_mm: f64,
     /// Samples where the surface has no normal (singular points); not measured.
     pub singular_samples: usize,
-    /// Extra measurements at cusps located between samples (they enter the maximum only).
+    /// Extra measurements: at cusps located between samples, in refined cells, and the
+    /// coarse pass's (they enter the maxima only).
     pub cusp_samples: usize,
 }
 
