@@ -39,7 +39,7 @@ const REFINE_DEPTH: usize = 4;
 /// Largest Newton step, in cells.
 const GOUGE_STEP_CELLS: f64 = 2.0;
 /// The coarse pass before a bounded simulation takes one sample in this many
-/// ([`seed_floor`]).
+/// ([`seed_pass`]).
 const SEED_SHARE: usize = 16;
 /// Share of the progress the coarse pass stands for.
 const SEED_PROGRESS: f64 = 0.05;
@@ -162,7 +162,7 @@ struct Ctx<'a> {
     opts: &'a VerifyOptions,
     rest: &'a RestMask,
     /// Material left and gouge depth (mm) measured somewhere on the surface before the
-    /// bands run (by [`seed_floor`]), if they were: the overall maxima are at least these,
+    /// bands run (by [`seed_pass`], summed up by [`seed_floor`]), if they were: the overall maxima are at least these,
     /// so a cell whose bound is within [`REFINE_SHARE`] of the scallop above them is bounded
     /// closely enough without refining it, whatever its band has measured so far.
     floor: Option<[f64; 2]>,
