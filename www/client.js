@@ -11,6 +11,21 @@ export class CancelledError extends Error {
   }
 }
 
+/** The engine's wasm, fetched and compiled (streamed, off the page's thread) once per page
+ * while the first worker starts, and handed to every worker: a worker started again after a
+ * Cancel neither fetches nor compiles it. Resolves to null where the browser cannot (the
+ * worker then loads the wasm itself, and says what failed). */
+let compiled = null;
+function compiledEngine() {
+  if (!compiled) {
+    const url = new URL('./pkg/tspath_bg.wasm', import.meta.url);
+    compiled = typeof WebAssembly.compileStreaming === 'function'
+      ? WebAssembly.compileStreaming(fetch(url)).catch(() => null)
+      : Promise.resolve(null);
+  }
+  return compiled;
+}
+
 export class EngineClient {
   constructor() {
     this.workerUrl = new URL('./worker.js', import.meta.url);
@@ -29,7 +44,7 @@ export class EngineClient {
       for (const p of this.pending.values()) p.reject(err);
       this.pending.clear();
     };
-    const started = this.#send('init', []).then((info) => {
+    const started = compiledEngine().then((module) => this.#send('init', [module])).then((info) => {
       this.info = info;
       return info;
     });

@@ -5,9 +5,10 @@ import init, * as wasm from './pkg/tspath.js';
 
 let ready = null;
 
-/** Loads and instantiates the wasm module once. */
-export function loadEngine() {
-  if (!ready) ready = init().then(() => wasm);
+/** Loads and instantiates the wasm module once: from `module` (a compiled
+ * WebAssembly.Module) when given, else fetched and compiled here. */
+export function loadEngine(module = null) {
+  if (!ready) ready = init(module ? { module_or_path: module } : undefined).then(() => wasm);
   return ready;
 }
 

@@ -451,13 +451,17 @@ export class TspathPlanner extends HTMLElement {
   async #start() {
     this.state = 'starting';
     this.client = new EngineClient();
-    const viewReady = this.#createView();
+    // The view (three.js) and the engine (the worker's wasm) start side by side, and the
+    // first model is loaded as soon as the engine is up: #load waits for the view only to
+    // draw (on the test machine the view was ready last, and the model waited for it).
+    this.viewReady = this.#createView();
+    this.viewReady.catch(() => {}); // said by #load, which awaits it
     this.#buildParams();
     this.#bindUi();
     this.#buildGlossary();
     let info;
     try {
-      [info] = await Promise.all([this.client.ready, viewReady]);
+      info = await this.client.ready;
     } catch (e) {
       this.state = 'error';
       this.#status(`The engine failed to start: ${e.message}`, true);
@@ -512,17 +516,17 @@ export class TspathPlanner extends HTMLElement {
 
   async #createView() {
     const canvas = this.$('view');
-    const probe = document.createElement('canvas');
-    let webgl = false;
-    try {
-      webgl = !!(probe.getContext('webgl2') || probe.getContext('webgl'));
-    } catch {
-      webgl = false;
-    }
-    if (webgl) {
+    // No probe canvas first: three.js throws when the canvas gives no WebGL 2 context, and
+    // the 2D view takes the canvas then (a failed getContext binds no context to it).
+    if (typeof WebGL2RenderingContext !== 'undefined') {
       try {
         const { View3D } = await import('./view3d.js');
         this.view = new View3D(canvas);
+        try {
+          this.view.warmUp();
+        } catch (e) {
+          console.warn('could not compile the shaders ahead:', e); // the first draw does
+        }
       } catch (e) {
         console.warn('WebGL view failed, using the 2D view:', e);
         this.view = null;
@@ -851,6 +855,7 @@ export class TspathPlanner extends HTMLElement {
     let m;
     try {
       m = await this.client.load(source);
+      await this.viewReady;
     } catch (e) {
       this.state = this.model ? (this.plan ? 'planned' : 'model-loaded') : 'error';
       this.#status(`Could not open ${label}: ${e.message}`, true);
@@ -882,6 +887,8 @@ export class TspathPlanner extends HTMLElement {
     this.view.renderNow();
     if (this.dataset.firstDrawMs === undefined) {
       this.dataset.firstDrawMs = String(Math.round(performance.now() - this.t0));
+      // From the navigation's start (the page's clock), what a visitor waits.
+      this.dataset.firstDrawAtMs = String(Math.round(performance.now()));
     }
     this.$('download-stl').disabled = false;
     this.$('save-job').disabled = false;

@@ -4,14 +4,27 @@
 // curve's cells and tree and the watershed rectangles (off until shown), the tool path by
 // patch with links and retractions drawn apart, and the tool (ball, shank, holder).
 // Z is up; lengths are millimetres. Renders on demand, not in a loop.
-import * as THREE from './vendor/three.module.js';
-import { OrbitControls } from './vendor/OrbitControls.js';
+import * as THREE from './vendor/three-view.js';
+import { OrbitControls } from './vendor/three-view.js';
 import {
   BACKGROUND, CAGE_COLOUR, EP_COLOUR, GRID, ISFC_LAYER, KINDS, PATCH_COLOURS, RECT_LAYER, REST_REASONS, STOCK, VIEWS, ZERO_TRIAD, boxEdges, heatColour, pathColour, tableGrid,
 } from './colours.js';
 
 const ORBIT_STEP_RAD = Math.PI / 36; // arrow keys: 5°
 const FOV_DEG = 35;
+
+/** The model surface's material: per-corner colours (patches or heat), both sides lit. */
+function surfaceMaterial() {
+  return new THREE.MeshPhongMaterial({
+    vertexColors: true, side: THREE.DoubleSide, shininess: 25,
+    polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+  });
+}
+
+/** The stock block's translucent faces. */
+function stockMaterial() {
+  return new THREE.MeshBasicMaterial({ color: STOCK.face, transparent: true, opacity: STOCK.opacity, depthWrite: false, side: THREE.DoubleSide });
+}
 
 export class View3D {
   constructor(canvas) {
@@ -69,6 +82,26 @@ export class View3D {
     });
   }
 
+  /** Compiles the shader programs the first drawing of a model needs (the surface, its lines
+   * and the stock's faces), while the page waits for the model. The materials stay referenced
+   * so three.js keeps their programs for the model's own materials, which share their keys. */
+  warmUp() {
+    const tri = new THREE.BufferGeometry();
+    const one = () => new THREE.BufferAttribute(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]), 3);
+    tri.setAttribute('position', one());
+    tri.setAttribute('normal', one());
+    tri.setAttribute('color', one());
+    const scene = new THREE.Scene();
+    scene.add(
+      new THREE.Mesh(tri, surfaceMaterial()),
+      new THREE.Mesh(tri, stockMaterial()),
+      new THREE.LineSegments(tri, new THREE.LineBasicMaterial({ vertexColors: true, depthTest: false })),
+      new THREE.LineSegments(tri, new THREE.LineBasicMaterial({ color: STOCK.edge })),
+    );
+    this.renderer.compile(scene, this.camera, this.scene);
+    this.warm = scene;
+  }
+
   renderNow() {
     for (const [k, on] of Object.entries(this.layers)) this.groups[k].visible = on;
     this.renderer.render(this.scene, this.camera);
@@ -108,11 +141,7 @@ export class View3D {
     geom.setAttribute('normal', new THREE.BufferAttribute(nor, 3));
     geom.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * nc), 3));
     geom.computeBoundingSphere();
-    const mat = new THREE.MeshPhongMaterial({
-      vertexColors: true, side: THREE.DoubleSide, shininess: 25,
-      polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
-    });
-    this.surface = new THREE.Mesh(geom, mat);
+    this.surface = new THREE.Mesh(geom, surfaceMaterial());
     this.groups.surface.add(this.surface);
     this.#colourSurface();
 
@@ -148,7 +177,7 @@ export class View3D {
       const d = [0, 1, 2].map((k) => Math.max(stock.max[k] - stock.min[k], 1e-6));
       const box = new THREE.Mesh(
         new THREE.BoxGeometry(d[0], d[1], d[2]),
-        new THREE.MeshBasicMaterial({ color: STOCK.face, transparent: true, opacity: STOCK.opacity, depthWrite: false, side: THREE.DoubleSide }),
+        stockMaterial(),
       );
       box.position.set(...[0, 1, 2].map((k) => 0.5 * (stock.min[k] + stock.max[k])));
       const eg = new THREE.BufferGeometry();

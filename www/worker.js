@@ -5,7 +5,7 @@
 // {id, ok: false, error}, and while planning posts {id, progress} (fraction done). Large
 // arrays travel as transferred typed arrays. A request cannot be interrupted once running:
 // the page cancels by terminating this worker and starting a new one (see client.js).
-import { engineInfo, loadBytes, loadSample } from './engine.js';
+import { engineInfo, loadBytes, loadEngine, loadSample } from './engine.js';
 
 const KIND_NAMES = ['feed', 'link', 'retract', 'rapid', 'plunge', 'approach'];
 /** Least progress interval posted to the page (ms): enough for a smooth bar. */
@@ -82,7 +82,9 @@ function planResult() {
 }
 
 const ops = {
-  async init() {
+  /** Starts the engine from `module` (the page's compiled wasm; null: fetch it here). */
+  async init(module) {
+    await loadEngine(module);
     return { result: await engineInfo() };
   },
 

@@ -247,8 +247,9 @@ test('the page opens and draws the first model with WebGL', async (page, url) =>
   await waitState(page, 'model-loaded', 20000);
   const wall = Date.now() - t0;
   const inPage = Number(await attr(page, 'data-first-draw-ms'));
-  const nav = await page.evaluate(() => performance.now());
-  measured.firstDraw = { wall, inPage };
+  const fromNav = Number(await attr(page, 'data-first-draw-at-ms'));
+  measured.firstDraw = { wall, inPage, fromNav };
+  check(fromNav >= inPage && fromNav <= wall + 50, `first draw at ${fromNav} ms of the page's clock, ${inPage} ms after the element started, ${wall} ms from goto`);
   check(await attr(page, 'data-renderer') === 'webgl', 'headless Chromium (SwiftShader) should give the WebGL view');
   const gl = await page.evaluate(() => {
     const g = document.createElement('canvas').getContext('webgl2');
@@ -261,7 +262,7 @@ test('the page opens and draws the first model with WebGL', async (page, url) =>
   const summary = await page.textContent('#summary');
   check(/Patches\s*1/.test(summary) && /Size \(mm\)\s*56\.6 × 56\.6 × 20\.0/.test(summary), `summary: ${summary}`);
   await page.screenshot({ path: join(shots, 'model-loaded.png') });
-  return `first model drawn ${inPage} ms after the page started (${wall} ms from navigation to drawn; page clock ${Math.round(nav)} ms); WebGL renderer: ${gl}`;
+  return `first model drawn ${fromNav} ms from navigation (${inPage} ms after the element started; ${wall} ms from goto to the state seen); WebGL renderer: ${gl}`;
 });
 
 for (const name of SAMPLES) {
@@ -1919,7 +1920,8 @@ try {
 }
 console.log(`wasm: ${wasmBytes.length} bytes, ${wasmGz} gzipped (${(wasmGz / 1024).toFixed(1)} KB; target ≤ 400 KB)`);
 if (measured.firstDraw) {
-  console.log(`first model drawn: ${measured.firstDraw.inPage} ms after the page started, ${measured.firstDraw.wall} ms from navigation (target ≤ 1000 ms)`);
+  const f = measured.firstDraw;
+  console.log(`first model drawn: ${f.fromNav} ms from navigation, ${f.inPage} ms after the element started (target ≤ 1000 ms from navigation; tests/e2e/bench-first-draw.mjs times six runs)`);
 }
 if (measured.cancelMs !== undefined) console.log(`cancel: planning stopped ${measured.cancelMs.toFixed(1)} ms after the click`);
 console.log(`browser tests took ${((Date.now() - started) / 1000).toFixed(0)} s; screenshots in test-artifacts/e2e/`);
