@@ -26,7 +26,7 @@ const USAGE: &str = "usage:
               [--machine NAME|FILE.json] [--dialect NAME] [--units mm|inch]
               [--work-offset G54..G59] [-o OUT.nc] [--report REPORT.json]
               [--verify [--verify-samples N] [--verify-max-samples N]]
-              --verify simulates the cut, from N samples (default 1 000 000; at least a
+              --verify simulates the cut, from N samples (default 100 000; at least a
               spacing of a quarter of sqrt(8 r h)) up to at most --verify-max-samples
               (default 8 000 000) until its error bound is a quarter of the scallop
               exits with 3 after writing its outputs when the plan has problems (rest area,

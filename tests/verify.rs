@@ -765,3 +765,48 @@ fn a_preview_measures_the_same_samples_and_heat_map_and_claims_no_bound() {
     assert!(p.max_scallop_mm <= f.max_scallop_mm);
     assert_eq!(p.mean_scallop_mm.to_bits(), f.mean_scallop_mm.to_bits());
 }
+
+/// A plan's verification from its default start ([`verify::PLAN_VERIFY_SAMPLES`], more where
+/// the first round's spacing rule asks for more) measures the convex keycap's largest
+/// scallop as a start of 1 000 000 samples does, within the sum of their error bounds, and
+/// both bounds reach a quarter of h: the million samples the default was before are a
+/// second, denser measurement of the same cut.
+#[test]
+fn a_plans_default_start_measures_what_a_million_samples_do() {
+    let (r, h) = (0.5, 0.01);
+    let m = samples::load_sample("keycap-convex").unwrap();
+    let opts = PlanOptions::default().with_tool_radius(r).with_scallop(h);
+    let planned = tspath::plan::plan(&m, &opts, &mut |_| true).unwrap();
+    let cap = verify::PLAN_VERIFY_MAX_SAMPLES;
+    let default = verify::verify_plan(&m, &planned, &opts, None, cap).unwrap();
+    let dense = verify::verify_plan(&m, &planned, &opts, Some(1_000_000), cap).unwrap();
+    println!(
+        "default start: {} samples, max scallop {:.6} mm (bound {:.2e}); 1 000 000: {} samples, {:.6} mm (bound {:.2e})",
+        default.samples,
+        default.max_scallop_mm,
+        default.error_bound_mm,
+        dense.samples,
+        dense.max_scallop_mm,
+        dense.error_bound_mm
+    );
+    assert!(default.samples >= verify::PLAN_VERIFY_SAMPLES);
+    assert!(
+        default.samples < dense.samples / 4,
+        "the default start should sample the small keycap more coarsely"
+    );
+    for v in [&default, &dense] {
+        assert!(
+            v.error_bound_mm <= verify::PLAN_BOUND_SHARE * h,
+            "{}",
+            v.error_bound_mm
+        );
+        assert_eq!(v.gouge_count, 0);
+    }
+    assert!(
+        (default.max_scallop_mm - dense.max_scallop_mm).abs()
+            <= default.error_bound_mm + dense.error_bound_mm,
+        "{} vs {}",
+        default.max_scallop_mm,
+        dense.max_scallop_mm
+    );
+}

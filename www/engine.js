@@ -20,6 +20,7 @@ export async function engineInfo() {
     samples: w.sampleNames(),
     machines: w.machineNames().map((name) => ({ name, json: w.machineJson(name), reachTiltDeg: w.machineReachableTiltDeg(name) })),
     dialects: w.dialectNames(),
+    verifySamples: w.planVerifySamples(),
     verifyMaxSamples: w.planVerifyMaxSamples(),
     paperLeadDeg: w.paperLeadDeg(),
   };

@@ -66,7 +66,7 @@ export const PARAMS = [
   // As `tspath plan --verify --verify-samples N --verify-max-samples M`: the simulation
   // starts at `samples` and grows until its error bound is a quarter of the scallop, or
   // until `max-samples`.
-  { key: 'samples', field: null, group: 'sim', label: 'Simulation samples to start with', unit: 'points', kind: 'number', min: 10000, max: 20000000, step: 10000, default: 1000000, integer: true },
+  { key: 'samples', field: null, group: 'sim', label: 'Simulation samples to start with', unit: 'points', kind: 'number', min: 10000, max: 20000000, step: 10000, default: 100000, integer: true },
   { key: 'max-samples', field: null, group: 'sim', label: 'Most simulation samples (grown to prove the scallop)', unit: 'points', kind: 'number', min: 10000, max: 50000000, step: 100000, default: 8000000, integer: true },
 ];
 

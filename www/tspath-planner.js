@@ -481,6 +481,9 @@ export class TspathPlanner extends HTMLElement {
     files.label = PUBLIC_SOURCE.group;
     for (const m of PUBLIC_MODELS) files.append(new Option(`${m.file} (${m.what})`, m.id));
     this.$('sample').append(builtIn, files);
+    if (info.verifySamples !== byKey.samples.default) {
+      console.warn(`The engine's simulation starts from ${info.verifySamples} samples, the page's default ${byKey.samples.default}`);
+    }
     if (info.verifyMaxSamples !== byKey['max-samples'].default) {
       console.warn(`The engine's simulation cap is ${info.verifyMaxSamples} samples, the page's default ${byKey['max-samples'].default}`);
     }
@@ -1762,7 +1765,7 @@ export class TspathPlanner extends HTMLElement {
     }
     const bound = plan.options.scallop_mm * VERIFY_BOUND_SHARE;
     const cap = values['max-samples'];
-    const what = ` Simulating the cut (from ${int(start)} samples until its error bound is ${mm(bound, 4)}, at most ${int(cap)} samples)…`;
+    const what = ` Simulating the cut (from at least ${int(start)} samples until its error bound is ${mm(bound, 4)}, at most ${int(cap)} samples)…`;
     // An error shown meanwhile (a value typed during the preview) stays until the user acts.
     const erring = () => this.$('status').classList.contains('error');
     if (!erring()) this.#planStatus(what);

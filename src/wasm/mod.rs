@@ -84,6 +84,13 @@ pub fn machine_reachable_tilt_deg(name: &str) -> Result<f64, JsError> {
         .map_err(js_err)
 }
 
+/// Fewest samples a plan's cutting simulation starts with unless told otherwise (`samples` of
+/// `Model.verify`; more where the spacing rule asks for more): as `tspath plan --verify`.
+#[wasm_bindgen(js_name = planVerifySamples)]
+pub fn plan_verify_samples() -> f64 {
+    verify::PLAN_VERIFY_SAMPLES as f64
+}
+
 /// Most samples a plan's cutting simulation grows to while aiming for its error bound
 /// unless told otherwise (`max_samples` of `Model.verify`): the same cap as
 /// `tspath plan --verify` uses, so the page's default measures a plan as the CLI does.
