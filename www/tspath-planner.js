@@ -28,9 +28,16 @@ import { GROUPS, PARAMS, byKey, flagOn, placement, planOptions, validate } from 
 const AUTO_REPLAN_MS = 1500;
 /** Pause after the last change before an automatic re-plan (ms). */
 const REPLAN_DELAY_MS = 300;
-/** Samples of the preview heat map shown while the simulation runs (at most a quarter of the
- * simulation's start). */
+/** Samples of the preview heat map shown while the simulation runs (at most a quarter of
+ * what the simulation's first round samples). */
 const PREVIEW_SAMPLES = 100000;
+/** A simulation whose first round samples fewer than this shows no preview: its final heat
+ * map comes about as soon as a preview would (the convex keycap at the defaults, 153 476
+ * samples: 0.5 s in wasm on the test machine, of which a preview took 0.2 s more). */
+const PREVIEW_WORTH_SAMPLES = 400000;
+/** The simulation's first round spaces its samples by this share of the flat-surface
+ * stepover sqrt(8 r h) at least (the engine's FIRST_SPACING_SHARE). */
+const FIRST_SPACING_SHARE = 0.25;
 /** G-code lines shown around the current one. */
 const LISTING_LINES = 13;
 /** Patches listed one row each in the patch legend; beyond, one swatch per colour. */
@@ -1747,8 +1754,11 @@ export class TspathPlanner extends HTMLElement {
     if (!(await this.#ensureWorkerPlan())) return;
     const start = values.samples;
     // A coarse heat map first (no bound between samples: a small share of the work), shown
-    // while the simulation that proves the scallop runs.
-    const preview = Math.min(PREVIEW_SAMPLES, Math.floor(start / 4));
+    // while the simulation that proves the scallop runs, where that takes a while: its first
+    // round samples `start`, or the model's area at the spacing rule's density if more.
+    const step = FIRST_SPACING_SHARE * Math.sqrt(8 * plan.options.tool_radius_mm * plan.options.scallop_mm);
+    const first = Math.max(start, this.model.area_mm2 / (step * step));
+    const preview = first < PREVIEW_WORTH_SAMPLES ? 0 : Math.min(PREVIEW_SAMPLES, Math.floor(first / 4));
     if (preview >= byKey.samples.min) {
       if (!this.$('status').classList.contains('error')) this.#planStatus(` Simulating a preview of the cut from ${int(preview)} samples…`);
       try {

@@ -454,9 +454,29 @@ test('heat map overlay from the cutting simulation', async (page, url) => {
   return `heat map recolours ${changed} px; re-planned on change to ${cl} CL points`;
 });
 
-test('progressive simulation: a preview heat map from a quarter of the start shows while the simulation at the page defaults runs, then the final one', async (page, url) => {
-  const t0 = Date.now();
+test('progressive simulation: at the page defaults the short simulation of the keycap shows its final heat map at once; a longer one shows a preview first, then the final one', async (page, url) => {
+  // The defaults: the first round samples 153 476 points, under the 400 000 a preview is
+  // worth, so no preview.
   await page.goto(`${url}?model=keycap-convex&plan=1`);
+  await page.evaluate((host) => {
+    const el = document.querySelector(host);
+    window.previewSeen = false;
+    new MutationObserver(() => {
+      if (el.getAttribute('data-preview') === 'shown') window.previewSeen = true;
+    }).observe(el, { attributes: true, attributeFilter: ['data-preview'] });
+  }, HOST);
+  await waitVerified(page, 120000);
+  check(!(await page.evaluate(() => window.previewSeen)), 'no preview before a short simulation');
+  const quick = {
+    samples: (await stat(page, 'samples')).text,
+    fromPlan: Number(await attr(page, 'data-plan-to-final-ms')),
+    plan: (await stat(page, 'plan_ms')).text,
+    sim: (await stat(page, 'verify_ms')).text,
+  };
+  // h 0.003 mm: 512 000 samples in the first round; the preview takes a quarter, at most
+  // 100 000.
+  const t0 = Date.now();
+  await page.goto(`${url}?model=keycap-convex&scallop=0.003&plan=1`);
   // The look and the click in the same turn of the page's event loop as the moment the
   // preview is seen, so the final result cannot arrive between them (on a busy machine it
   // came between separate calls).
@@ -476,18 +496,17 @@ test('progressive simulation: a preview heat map from a quarter of the start sho
   check(seen.verify === 'running', 'the simulation still runs under the preview');
   check(!seen.disabled, 'the heat map can be shown from the preview');
   const legend = seen.legend;
-  // A quarter of the page's start (100 000 samples), at most 100 000.
-  check(/Preview from 25,000 samples/.test(legend), `the legend says it is a preview: ${legend}`);
+  check(/Preview from 100,000 samples/.test(legend), `the legend says it is a preview: ${legend}`);
   await page.screenshot({ path: join(shots, 'heat-preview.png') });
   await waitVerified(page, 120000);
   const tFinal = Date.now() - t0;
   check((await attr(page, 'data-preview')) === null, 'the preview is gone once simulated');
   const after = await page.textContent('#heat-legend');
-  check(!/Preview/.test(after) && /0\.01 mm left/.test(after), `the final legend: ${after}`);
+  check(!/Preview/.test(after) && /0\.003 mm left/.test(after), `the final legend: ${after}`);
   const samples = (await stat(page, 'samples')).text;
   const fromPlan = Number(await attr(page, 'data-plan-to-final-ms'));
   check(fromPlan > 0 && fromPlan <= tFinal, `Plan to final heat map ${fromPlan} ms, within the ${tFinal} ms from navigation`);
-  return `from navigation: preview heat map after ${tPreview} ms, final after ${tFinal} ms (${samples} samples); from Plan to the final map ${fromPlan} ms (planning ${(await stat(page, 'plan_ms')).text}, simulation ${(await stat(page, 'verify_ms')).text})`;
+  return `defaults: from Plan to the final map ${quick.fromPlan} ms (planning ${quick.plan}, simulation ${quick.sim}, ${quick.samples} samples), no preview; h 0.003 mm: preview heat map after ${tPreview} ms from navigation, final after ${tFinal} ms (${samples} samples)`;
 });
 
 /** Drops a file on the view, as a user drags one from the desktop. */
