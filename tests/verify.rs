@@ -766,6 +766,20 @@ fn a_preview_measures_the_same_samples_and_heat_map_and_claims_no_bound() {
     assert_eq!(p.mean_scallop_mm.to_bits(), f.mean_scallop_mm.to_bits());
 }
 
+/// The first round of a bounded simulation samples a surface's area at a quarter of the
+/// flat-surface stepover: a 10 × 10 mm plane (area exact) at r 0.5, h 0.01 mm, a spacing of
+/// 0.05 mm, takes 40 000 samples.
+#[test]
+fn the_first_round_samples_the_area_at_a_quarter_of_the_stepover() {
+    let n = verify::first_round_samples(&plane(10.0), 0.5, 0.01);
+    assert!(n.abs_diff(40_000) <= 1, "{n}");
+    // Four times the area, four times the samples; a quarter of the scallop, four times too.
+    let big = verify::first_round_samples(&plane(20.0), 0.5, 0.01);
+    assert!(big.abs_diff(160_000) <= 1, "{big}");
+    let fine = verify::first_round_samples(&plane(10.0), 0.5, 0.0025);
+    assert!(fine.abs_diff(160_000) <= 1, "{fine}");
+}
+
 /// A plan's verification from its default start ([`verify::PLAN_VERIFY_SAMPLES`], more where
 /// the first round's spacing rule asks for more) measures the convex keycap's largest
 /// scallop as a start of 1 000 000 samples does, within the sum of their error bounds, and

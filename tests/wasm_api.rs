@@ -402,11 +402,6 @@ fn the_simulation_cap_is_the_clis() {
         tspath::verify::PLAN_VERIFY_MAX_SAMPLES as f64
     );
     assert_eq!(tspath::wasm::plan_verify_max_samples(), 8_000_000.0);
-    // And the start, which the page's `samples` default is checked against.
-    assert_eq!(
-        tspath::wasm::plan_verify_samples(),
-        tspath::verify::PLAN_VERIFY_SAMPLES as f64
-    );
 }
 
 /// Plan options as a JavaScript object.

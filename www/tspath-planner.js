@@ -35,9 +35,6 @@ const PREVIEW_SAMPLES = 100000;
  * map comes about as soon as a preview would (the convex keycap at the defaults, 153 476
  * samples: 0.5 s in wasm on the test machine, of which a preview took 0.2 s more). */
 const PREVIEW_WORTH_SAMPLES = 400000;
-/** The simulation's first round spaces its samples by this share of the flat-surface
- * stepover sqrt(8 r h) at least (the engine's FIRST_SPACING_SHARE). */
-const FIRST_SPACING_SHARE = 0.25;
 /** G-code lines shown around the current one. */
 const LISTING_LINES = 13;
 /** Patches listed one row each in the patch legend; beyond, one swatch per colour. */
@@ -1755,9 +1752,8 @@ export class TspathPlanner extends HTMLElement {
     const start = values.samples;
     // A coarse heat map first (no bound between samples: a small share of the work), shown
     // while the simulation that proves the scallop runs, where that takes a while: its first
-    // round samples `start`, or the model's area at the spacing rule's density if more.
-    const step = FIRST_SPACING_SHARE * Math.sqrt(8 * plan.options.tool_radius_mm * plan.options.scallop_mm);
-    const first = Math.max(start, this.model.area_mm2 / (step * step));
+    // round samples `start`, or what the engine's spacing rule asks for if more.
+    const first = Math.max(start, plan.verifyFirstSamples);
     const preview = first < PREVIEW_WORTH_SAMPLES ? 0 : Math.min(PREVIEW_SAMPLES, Math.floor(first / 4));
     if (preview >= byKey.samples.min) {
       if (!this.$('status').classList.contains('error')) this.#planStatus(` Simulating a preview of the cut from ${int(preview)} samples…`);

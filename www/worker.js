@@ -58,6 +58,9 @@ function planResult() {
   const report = plan.report();
   const result = {
     report,
+    // What the simulation's first round samples at least (the page shows a preview only
+    // before a long one).
+    verifyFirstSamples: model.verifyFirstSamples(plan),
     cl: plan.clPoints(),
     cc: plan.ccPoints(),
     axes: plan.axes(),

@@ -440,7 +440,15 @@ const FIRST_SPACING_SHARE: f64 = 0.25;
 /// The fewest samples a bounded simulation starts with: a spacing of
 /// [`FIRST_SPACING_SHARE`] of the flat-surface stepover over the surface's area.
 fn first_samples(surface: &Surface, path: &CutterPath, opts: &VerifyOptions) -> usize {
-    let step = FIRST_SPACING_SHARE * (8.0 * path.tool_radius_mm * opts.scallop_mm).sqrt();
+    first_round_samples(surface, path.tool_radius_mm, opts.scallop_mm)
+}
+
+/// The samples the first round of a bounded simulation takes at least, for a ball of
+/// `tool_radius_mm` and a scallop of `scallop_mm`: the surface's area at a spacing of
+/// [`FIRST_SPACING_SHARE`] of the flat-surface stepover `sqrt(8 r h)` (it starts from the
+/// options' `samples` where they are more).
+pub fn first_round_samples(surface: &Surface, tool_radius_mm: f64, scallop_mm: f64) -> usize {
+    let step = FIRST_SPACING_SHARE * (8.0 * tool_radius_mm * scallop_mm).sqrt();
     let n = engine::area_mm2(surface) / (step * step);
     if n.is_finite() {
         n.ceil().min(MAX_SAMPLES as f64) as usize

@@ -772,6 +772,17 @@ fn verify_options(base: VerifyOptions, options: JsValue) -> Result<VerifyOptions
 
 #[wasm_bindgen(js_class = Model)]
 impl WasmModel {
+    /// The samples the first round of `plan`'s bounded simulation takes at least (the
+    /// model's area at the spacing rule's density; it starts from `samples` where more).
+    #[wasm_bindgen(js_name = verifyFirstSamples)]
+    pub fn verify_first_samples(&self, plan: &WasmPlan) -> f64 {
+        verify::first_round_samples(
+            &self.model.surface,
+            plan.opts.tool_radius_mm,
+            plan.opts.scallop_mm,
+        ) as f64
+    }
+
     /// Simulates the ball-end cut of `plan` on this model and measures scallops and gouges.
     /// `mesh` is the tessellation the page shows (from `tessellate`): the heat map has one
     /// value per vertex of it. `options` is a plain object with any of `samples`,
