@@ -1,6 +1,7 @@
 //! The cutter-location (CL) surface as a triangle mesh: per layout patch a grid in the
 //! patch's `(u, v)`, fine enough that the mesh of ball centres stays within the chordal
-//! tolerance of the true offset, each vertex a ball centre a tool radius along the exact
+//! tolerance of the true offset (its lines closer together where the curvature and the
+//! parameter speed ask, not evenly at the patch's worst), each vertex a ball centre a tool radius along the exact
 //! limit-surface normal (not a vertex normal of a coarse mesh) from its contact point.
 //!
 //! Where the surface is concave with a radius below the ball's, or folds, the offset
@@ -16,6 +17,94 @@ use crate::geom::{Point3, Vector3};
 use crate::model::Model;
 use crate::plan::stepover;
 use crate::surface::{DiffGeom, SurfaceDerivs};
+
+/// The grid cells per unit parameter that `u` and `v` of `patch` ask for, per interval
+/// between neighbouring samples: at each sample the parameter speed over the
+/// chord step whose sagitta is the chordal tolerance on the tighter of the surface's and
+/// the offset's curvature; per interval the largest at its ends and theirs beside (a peak
+/// between samples is not missed by a sample's width), the largest across the other
+/// direction.
+fn density(
+    patch: &crate::layout::Patch,
+    surface: &crate::surface::Surface,
+    r: f64,
+    chordal_mm: f64,
+) -> [Vec<f64>; 2] {
+    let n = SIZE_SAMPLES;
+    let k = (n - 1) as f64;
+    // Cells per unit parameter asked at each sample, the largest across the other side.
+    let mut at = [vec![0.0f64; n], vec![0.0f64; n]];
+    for a in 0..n {
+        for b in 0..n {
+            let d = patch.derivs(surface, a as f64 / k, b as f64 / k);
+            let Some(g) = DiffGeom::try_from_derivs(&d) else {
+                continue;
+            };
+            let (k1, k2) = g.principal();
+            let kk = k1.abs().max(k2.abs());
+            // The offset's curvature: κ / (1 − rκ) on the concave side (capped).
+            let kcl = if kk * r < 0.5 {
+                kk / (1.0 - kk * r)
+            } else {
+                2.0 * kk
+            };
+            let seg = stepover::chord_step(chordal_mm, kcl.max(kk));
+            if seg.is_finite() {
+                at[0][a] = at[0][a].max(d.su.norm() / seg);
+                at[1][b] = at[1][b].max(d.sv.norm() / seg);
+            }
+        }
+    }
+    at.map(|side| {
+        (0..n - 1)
+            .map(|i| {
+                side[i.saturating_sub(1)..(i + 3).min(n)]
+                    .iter()
+                    .copied()
+                    .fold(0.0, f64::max)
+            })
+            .collect()
+    })
+}
+
+/// Grid lines (patch parameters from 0 to 1) for [`density`] `d` times `scale`: per side
+/// the cells the density integrates to (at least [`MIN_CELLS`], at most [`MAX_CELLS`]),
+/// each holding an equal share of the integral (evenly spaced where it is zero).
+fn grid_lines(d: &[Vec<f64>; 2], scale: f64) -> [Vec<f64>; 2] {
+    [0, 1].map(|side| {
+        let w = 1.0 / d[side].len() as f64;
+        let cells: Vec<f64> = d[side].iter().map(|&c| c * scale * w).collect();
+        let sum: f64 = cells.iter().sum();
+        let n = if sum.is_finite() {
+            (sum.ceil() as usize).clamp(MIN_CELLS, MAX_CELLS)
+        } else {
+            MAX_CELLS
+        };
+        if !(sum > 0.0) || !sum.is_finite() {
+            return (0..=n).map(|i| i as f64 / n as f64).collect();
+        }
+        // Line i where the running integral reaches i / n of the whole, linear within an
+        // interval.
+        let mut lines = Vec::with_capacity(n + 1);
+        lines.push(0.0);
+        let (mut run, mut k) = (0.0, 0);
+        for i in 1..n {
+            let want = sum * i as f64 / n as f64;
+            while k + 1 < cells.len() && run + cells[k] < want {
+                run += cells[k];
+                k += 1;
+            }
+            let f = if cells[k] > 0.0 {
+                ((want - run) / cells[k]).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            lines.push((k as f64 + f) * w);
+        }
+        lines.push(1.0);
+        lines
+    })
+}
 
 /// A vertex of the CL mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,8 +133,8 @@ pub struct ClMesh {
 /// Fewest and most grid cells along a patch side.
 const MIN_CELLS: usize = 2;
 const MAX_CELLS: usize = 256;
-/// Samples per side of a patch that size its grid.
-const SIZE_SAMPLES: usize = 9;
+/// Samples per side of a patch that place its grid lines.
+const SIZE_SAMPLES: usize = 33;
 /// Most vertices of the whole mesh: beyond it the grids are coarsened (evenly).
 const MAX_VERTICES: usize = 2_000_000;
 
@@ -77,58 +166,33 @@ impl ClMesh {
         let side = model.tool_side();
         let surface = &model.surface;
         let layout = &model.layout;
-        // Cells per side of every patch from the fastest parameter speed and the tightest
-        // curvature of the offset over samples.
-        let mut sizes: Vec<[usize; 2]> = Vec::with_capacity(layout.len());
-        for patch in &layout.patches {
-            let (mut speed, mut kmax) = ([0.0f64; 2], 0.0f64);
-            let k = (SIZE_SAMPLES - 1) as f64;
-            for a in 0..SIZE_SAMPLES {
-                for b in 0..SIZE_SAMPLES {
-                    let d = patch.derivs(surface, a as f64 / k, b as f64 / k);
-                    speed[0] = speed[0].max(d.su.norm());
-                    speed[1] = speed[1].max(d.sv.norm());
-                    if let Some(g) = DiffGeom::try_from_derivs(&d) {
-                        let (k1, k2) = g.principal();
-                        let kk = k1.abs().max(k2.abs());
-                        // The offset's curvature: κ / (1 − rκ) on the concave side (capped).
-                        let kcl = if kk * r < 0.5 {
-                            kk / (1.0 - kk * r)
-                        } else {
-                            2.0 * kk
-                        };
-                        kmax = kmax.max(kcl.max(kk));
-                    }
-                }
-            }
-            let seg = stepover::chord_step(chordal_mm, kmax);
-            let cells = |s: f64| {
-                if seg.is_finite() {
-                    ((s / seg).ceil() as usize).clamp(MIN_CELLS, MAX_CELLS)
-                } else {
-                    MIN_CELLS
-                }
-            };
-            sizes.push([cells(speed[0]), cells(speed[1])]);
-        }
-        let total: usize = sizes.iter().map(|s| (s[0] + 1) * (s[1] + 1)).sum();
+        // Each patch's grid lines, placed by the density its samples ask for: the
+        // parameter speed over the chord the offset's curvature allows, the worst across
+        // the other direction.
+        let densities: Vec<[Vec<f64>; 2]> = layout
+            .patches
+            .iter()
+            .map(|patch| density(patch, surface, r, chordal_mm))
+            .collect();
+        let lines = |scale: f64| -> Vec<[Vec<f64>; 2]> {
+            densities.iter().map(|d| grid_lines(d, scale)).collect()
+        };
+        let mut breaks = lines(1.0);
+        let total: usize = breaks.iter().map(|[u, v]| u.len() * v.len()).sum();
         if total > MAX_VERTICES {
-            let f = (MAX_VERTICES as f64 / total as f64).sqrt();
-            for s in &mut sizes {
-                for n in s.iter_mut() {
-                    *n = ((*n as f64 * f).floor() as usize).max(MIN_CELLS);
-                }
-            }
+            // Coarsened evenly: the same density, scaled down.
+            breaks = lines((MAX_VERTICES as f64 / total as f64).sqrt());
         }
         let mut vertices = Vec::new();
         let mut triangles = Vec::new();
-        let mut patches = Vec::with_capacity(sizes.len());
-        for (pi, (patch, &[nu, nv])) in layout.patches.iter().zip(&sizes).enumerate() {
+        let mut patches = Vec::with_capacity(breaks.len());
+        for (pi, (patch, [us, vs])) in layout.patches.iter().zip(&breaks).enumerate() {
             let first = vertices.len() as u32;
+            let (nu, nv) = (us.len() - 1, vs.len() - 1);
             patches.push((first, [nu, nv]));
-            for j in 0..=nv {
-                for i in 0..=nu {
-                    let uv = [i as f64 / nu as f64, j as f64 / nv as f64];
+            for &v in vs {
+                for &u in us {
+                    let uv = [u, v];
                     let (cc, n) = match each.as_deref_mut() {
                         Some(f) => {
                             let (d, n) = patch.derivs_normal(surface, uv[0], uv[1]);

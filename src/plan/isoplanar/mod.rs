@@ -77,6 +77,11 @@ const BOUNDARY_JOIN_REL: f64 = 1e-7;
 /// (keycap-concave, r 0.5 mm, h 0.005 mm: 0.0027 mm cut in with the whole 0.002 mm allowed
 /// at the points, 0.0016 mm with half).
 const THIN_SHARE: f64 = 0.5;
+/// Where neighbouring slice points lie farther apart than this many flat spacings, the chord
+/// over them is checked against the curve every so far (see [`Emit::thin`]), at most
+/// [`MAX_GAP_CHECKS`] times per gap.
+const GAP_CHECK_SPACINGS: f64 = 0.5;
+const MAX_GAP_CHECKS: usize = 256;
 /// Most slice points one chord may stand for when thinning.
 const THIN_LOOKAHEAD: usize = 64;
 /// Share of the slicing's progress the pass checks take (after 0.6 of it).
@@ -934,32 +939,41 @@ impl<'a> SegmentIndex<'a> {
     /// `q` passes `keep` (given the offset and its length).
     fn nearest_where(&self, q: &Point3, keep: impl Fn(&Vector3, f64) -> bool) -> Option<f64> {
         // A point within the reach lies within it along the axis too; its segment begins at
-        // most the longest extent before it (the slack covers rounding).
+        // most the longest extent before it (the slack covers rounding). The search runs
+        // out from the query both ways along the axis, and the window narrows to the
+        // nearest found so far.
         let y = q.coords.dot(&self.axis);
         let slack = SEGMENT_WINDOW_SLACK * (self.reach + y.abs() + self.longest);
-        let (lo, hi) = (
-            y - self.reach - self.longest - slack,
-            y + self.reach + slack,
-        );
-        let first = self.order.partition_point(|e| e.0 < lo);
+        let mid = self.order.partition_point(|e| e.0 < y);
         let mut best: Option<f64> = None;
-        // Where walls run across the axis many segments share a window: their boxes, grown
-        // by the reach, turn most away cheaply.
-        let r = self.reach + slack;
-        for (start, i, bounds) in &self.order[first..] {
-            if *start > hi {
-                break;
-            }
+        let bound = |best: Option<f64>| best.map_or(self.reach, |b| b.min(self.reach)) + slack;
+        let test = |e: &(f64, u32, Aabb), best: &mut Option<f64>| {
+            let r = bound(*best);
+            // Where walls run across the axis many segments share a window: their boxes,
+            // grown by the reach, turn most away cheaply.
+            let (_, i, bounds) = e;
             if (0..3).any(|k| q[k] < bounds.min[k] - r || q[k] > bounds.max[k] + r) {
-                continue;
+                return;
             }
             let (a, b) = self.segments[*i as usize];
             let v = nearest_on_segment(q, &a, &b) - q;
             let d = v.norm();
             // `keep` last: it is asked only of a point that would be the nearest so far.
             if d <= self.reach && best.is_none_or(|x| d < x) && keep(&v, d) {
-                best = Some(d);
+                *best = Some(d);
             }
+        };
+        for e in &self.order[mid..] {
+            if e.0 > y + bound(best) {
+                break;
+            }
+            test(e, &mut best);
+        }
+        for e in self.order[..mid].iter().rev() {
+            if e.0 < y - bound(best) - self.longest {
+                break;
+            }
+            test(e, &mut best);
         }
         best
     }
@@ -1170,25 +1184,35 @@ impl Emit<'_> {
         if n < 3 {
             return Ok(points);
         }
-        // The curve half-way between neighbours too (where a chord dips furthest from it).
-        let mut middles: Vec<Option<SurfacePoint>> = Vec::with_capacity(n);
+        // The curve between neighbours too (where a chord dips furthest from it): half-way,
+        // and where neighbours lie far apart (the mesh is coarse where the surface is
+        // gently curved) every half flat spacing, so that a long chord is not checked only
+        // at a few points. `between[i]` starts the points of gap `i` in `middles`.
+        let mut middles: Vec<SurfacePoint> = Vec::with_capacity(n);
+        let mut between: Vec<usize> = Vec::with_capacity(n);
         for w in points.windows(2) {
-            middles.push(if w[0].patch == w[1].patch {
+            between.push(middles.len());
+            if w[0].patch != w[1].patch {
+                continue;
+            }
+            let parts = self.gap_checks(&w[0], &w[1]);
+            for k in 1..parts {
+                let t = k as f64 / parts as f64;
                 let uv = [
-                    0.5 * (w[0].uv[0] + w[1].uv[0]),
-                    0.5 * (w[0].uv[1] + w[1].uv[1]),
+                    w[0].uv[0] + t * (w[1].uv[0] - w[0].uv[0]),
+                    w[0].uv[1] + t * (w[1].uv[1] - w[0].uv[1]),
                 ];
-                Some(self.point(w[0].patch, uv)?)
-            } else {
-                None
-            });
+                middles.push(self.point(w[0].patch, uv)?);
+            }
         }
+        between.push(middles.len());
         let holds = |i: usize, j: usize| {
             let (a, b) = (&points[i], &points[j]);
             let on = |m: &SurfacePoint| m.patch == a.patch && self.chord_holds(a, b, m, THIN_SHARE);
             a.patch == b.patch
                 && points[i + 1..j].iter().all(on)
-                && middles[i..j].iter().all(|m| m.as_ref().is_some_and(on))
+                && (i..j).all(|g| between[g + 1] > between[g])
+                && middles[between[i]..between[j]].iter().all(on)
         };
         let mut keep = vec![0];
         let mut i = 0;
@@ -1223,6 +1247,15 @@ impl Emit<'_> {
         Ok(keep.into_iter().map(|k| points[k]).collect())
     }
 
+    /// Into how many equal parts the chord from `a` to `b` is cut where it is checked
+    /// against the curve: two (its middle), more where it is longer than
+    /// [`GAP_CHECK_SPACINGS`] flat spacings (at most [`MAX_GAP_CHECKS`]).
+    fn gap_checks(&self, a: &SurfacePoint, b: &SurfacePoint) -> usize {
+        ((b.cc - a.cc).norm() / (GAP_CHECK_SPACINGS * self.spacing))
+            .ceil()
+            .clamp(2.0, MAX_GAP_CHECKS as f64) as usize
+    }
+
     /// Adds to `out` the points strictly between `pa` and `pb` (same patch) on the straight
     /// parameter line between them that bring the chords within the limits.
     fn split(
@@ -1236,8 +1269,21 @@ impl Emit<'_> {
             return Ok(());
         }
         let (ua, ub) = (pa.uv, pb.uv);
-        let pm = self.point(pa.patch, [0.5 * (ua[0] + ub[0]), 0.5 * (ua[1] + ub[1])])?;
-        if self.chord_holds(pa, pb, &pm, 1.0) {
+        let at = |t: f64| [ua[0] + t * (ub[0] - ua[0]), ua[1] + t * (ub[1] - ua[1])];
+        let pm = self.point(pa.patch, at(0.5))?;
+        // The middle, and on a long chord (neighbours far apart where the mesh is coarse)
+        // points every half flat spacing: where the curvature is uneven along the chord its
+        // middle alone can hold while it dips in elsewhere.
+        let parts = self.gap_checks(pa, pb);
+        let mut holds = self.chord_holds(pa, pb, &pm, 1.0);
+        for k in (1..parts).filter(|&k| 2 * k != parts) {
+            if !holds {
+                break;
+            }
+            let q = self.point(pa.patch, at(k as f64 / parts as f64))?;
+            holds = self.chord_holds(pa, pb, &q, 1.0);
+        }
+        if holds {
             return Ok(());
         }
         self.split(pa, &pm, depth - 1, out)?;
