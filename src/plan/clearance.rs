@@ -27,6 +27,8 @@ const OWN_HOLDER_SET: f64 = 2.0;
 /// The model as seen by the shank and by the holder.
 pub struct Clearance {
     shank: SurfaceDistance,
+    /// The chordal tolerance the shank's tessellation was asked for (mm).
+    shank_chordal_mm: f64,
     /// `None`: the holder is tested against the shank's triangles.
     holder: Option<SurfaceDistance>,
 }
@@ -44,7 +46,18 @@ impl Clearance {
         let coarse = chordal(opts.holder_radius_mm).max(fine);
         let shank = SurfaceDistance::new(model, fine);
         let holder = (coarse > OWN_HOLDER_SET * fine).then(|| SurfaceDistance::new(model, coarse));
-        Clearance { shank, holder }
+        Clearance {
+            shank,
+            shank_chordal_mm: fine,
+            holder,
+        }
+    }
+
+    /// The shank's tessellation, if it was asked for a chordal tolerance of at most
+    /// `chordal_mm` (mm) times `coarser`: another check that needs one about as fine can
+    /// use it instead of tessellating again (adding its measured deviation to its margins).
+    pub fn shank_set_within(&self, chordal_mm: f64, coarser: f64) -> Option<&SurfaceDistance> {
+        (self.shank_chordal_mm <= coarser * chordal_mm).then_some(&self.shank)
     }
 
     fn holder(&self) -> &SurfaceDistance {

@@ -33,6 +33,10 @@ const GOUGE_LIFT_SHARE: f64 = 0.2;
 /// radius (at least the overcut allowed): air moves that do not go straight up lead off
 /// the surface by about twice this first ([`super::air`]).
 const AIR_TESSELLATION_SHARE: f64 = 0.04;
+/// The air moves are checked against the shank's tessellation when it was asked for a
+/// tolerance at most this many times theirs (one tessellation fewer; their lead-off grows
+/// with the tolerance).
+const AIR_SHARED_SET: f64 = 1.5;
 /// Rounds of leaving out cut points whose retract or approach finds no clear way, before
 /// the plan gives up.
 const MAX_ROUTE_ROUNDS: usize = 64;
@@ -150,12 +154,21 @@ pub fn finish(
     axes.spread = smooth::spread_turns(&obs, &mut draft.toolpath, opts, &why);
     // 3. Split the cuts there and route the air moves; where the ball cannot get to a cut or
     //    away from it, leave those points out too and split again.
-    let dist = SurfaceDistance::new(model, (AIR_TESSELLATION_SHARE * r).max(opts.overcut_mm()));
+    // The shank's tessellation serves where it is about as fine (a thin tool's shank).
+    let air_chordal = (AIR_TESSELLATION_SHARE * r).max(opts.overcut_mm());
+    let own_air_set;
+    let dist = match obs.shank_set_within(air_chordal, AIR_SHARED_SET) {
+        Some(d) => d,
+        None => {
+            own_air_set = SurfaceDistance::new(model, air_chordal);
+            &own_air_set
+        }
+    };
     let mut rounds = 0;
     let (mut path, air) = loop {
         let (mut path, origin) = reach::split(&draft, &why);
         axis::fill_air_axes(&mut path);
-        match air::route(model, &mut path, opts, &dist) {
+        match air::route(model, &mut path, opts, dist) {
             Routed::Done(stats) => break (path, stats),
             Routed::LeaveOut(cuts) => {
                 rounds += 1;

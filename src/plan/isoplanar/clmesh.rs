@@ -27,6 +27,7 @@ use crate::surface::{DiffGeom, SurfaceDerivs};
 fn density(
     patch: &crate::layout::Patch,
     surface: &crate::surface::Surface,
+    side: f64,
     r: f64,
     chordal_mm: f64,
 ) -> [Vec<f64>; 2] {
@@ -40,15 +41,22 @@ fn density(
             let Some(g) = DiffGeom::try_from_derivs(&d) else {
                 continue;
             };
+            // The offset's principal curvatures, κ / (1 − rκ) with κ seen from the tool's
+            // side (positive concave: there it grows, capped where the offset folds;
+            // convex it shrinks).
             let (k1, k2) = g.principal();
-            let kk = k1.abs().max(k2.abs());
-            // The offset's curvature: κ / (1 − rκ) on the concave side (capped).
-            let kcl = if kk * r < 0.5 {
-                kk / (1.0 - kk * r)
-            } else {
-                2.0 * kk
-            };
-            let seg = stepover::chord_step(chordal_mm, kcl.max(kk));
+            let kcl = [k1, k2]
+                .map(|k| {
+                    let k = k * side;
+                    if k * r < 0.5 {
+                        (k / (1.0 - k * r)).abs()
+                    } else {
+                        2.0 * k
+                    }
+                })
+                .into_iter()
+                .fold(0.0, f64::max);
+            let seg = stepover::chord_step(chordal_mm, kcl);
             if seg.is_finite() {
                 at[0][a] = at[0][a].max(d.su.norm() / seg);
                 at[1][b] = at[1][b].max(d.sv.norm() / seg);
@@ -172,7 +180,7 @@ impl ClMesh {
         let densities: Vec<[Vec<f64>; 2]> = layout
             .patches
             .iter()
-            .map(|patch| density(patch, surface, r, chordal_mm))
+            .map(|patch| density(patch, surface, side, r, chordal_mm))
             .collect();
         let lines = |scale: f64| -> Vec<[Vec<f64>; 2]> {
             densities.iter().map(|d| grid_lines(d, scale)).collect()

@@ -77,8 +77,13 @@ const BOUNDARY_JOIN_REL: f64 = 1e-7;
 /// (keycap-concave, r 0.5 mm, h 0.005 mm: 0.0027 mm cut in with the whole 0.002 mm allowed
 /// at the points, 0.0016 mm with half).
 const THIN_SHARE: f64 = 0.5;
+/// The same share for the points added between neighbours: where the mesh is coarse the
+/// neighbours lie far apart and a chord checked at a few points dips deeper between them
+/// (keycap-concave at those settings: 0.00100 mm cut in with the whole allowed, 0.00055
+/// with half).
+const SPLIT_SHARE: f64 = 0.5;
 /// Where neighbouring slice points lie farther apart than this many flat spacings, the chord
-/// over them is checked against the curve every so far (see [`Emit::thin`]), at most
+/// over them is checked against the curve every so far (see [`Emit::split`]), at most
 /// [`MAX_GAP_CHECKS`] times per gap.
 const GAP_CHECK_SPACINGS: f64 = 0.5;
 const MAX_GAP_CHECKS: usize = 256;
@@ -1123,6 +1128,24 @@ pub fn draft(
     Ok(d)
 }
 
+/// Points of a pass's contact curve and, per gap between neighbours, the curve points its
+/// chord was checked against when the gap was made (evaluated once, for the refining and
+/// the thinning both).
+#[derive(Default)]
+struct Curve {
+    points: Vec<SurfacePoint>,
+    checked: Vec<SurfacePoint>,
+    /// Per point, where the checks of the gap it begins start in `checked`.
+    starts: Vec<usize>,
+}
+
+impl Curve {
+    fn push(&mut self, p: SurfacePoint) {
+        self.points.push(p);
+        self.starts.push(self.checked.len());
+    }
+}
+
 /// What placing moves needs.
 struct Emit<'a> {
     model: &'a Model,
@@ -1154,65 +1177,56 @@ impl Emit<'_> {
     /// The slice's contact points, with points added between neighbours of one patch until
     /// the chords of the contact and ball-centre curves are within their limits.
     fn refine(&self, pts: &[SlicePoint]) -> Result<Vec<SurfacePoint>> {
-        let mut out: Vec<SurfacePoint> = Vec::with_capacity(pts.len());
+        let mut curve = Curve {
+            points: Vec::with_capacity(pts.len()),
+            checked: Vec::with_capacity(pts.len()),
+            starts: Vec::with_capacity(pts.len()),
+        };
         let mut prev: Option<SurfacePoint> = None;
         for s in pts {
             let p = self.point(s.patch, s.uv)?;
             if let Some(pp) = prev.filter(|pp| pp.patch == p.patch) {
-                self.split(&pp, &p, CHORD_DEPTH, &mut out)?;
+                self.split(&pp, &p, CHORD_DEPTH, &mut curve)?;
             }
             // Drop repeats (a slice through a mesh vertex crosses its edges there twice).
-            if out
+            if curve
+                .points
                 .last()
                 .is_none_or(|q: &SurfacePoint| (q.cc - p.cc).norm() > 1e-9)
             {
-                out.push(p);
+                curve.push(p);
             }
             prev = Some(p);
         }
-        self.thin(out)
+        self.thin(curve)
     }
 
-    /// `points` without those the chords of their neighbours already hold: from each point
-    /// kept, the next kept is one whose chord passes within the limits of every point
-    /// between while the next one's does not, found by doubling then halving: the farthest
-    /// such point wherever holding does not come back farther on. The slice points lie as
-    /// densely as the mesh's edges, far denser than the chordal tolerance asks for on gently
-    /// curved stretches.
-    fn thin(&self, points: Vec<SurfacePoint>) -> Result<Vec<SurfacePoint>> {
+    /// The points of `curve` without those the chords of their neighbours already hold:
+    /// from each point kept, the next kept is one whose chord passes within the limits of
+    /// every point between, and of the curve points each gap between was checked against
+    /// (where a chord dips furthest from the curve), while the next one's does not, found by
+    /// doubling then halving: the farthest such point wherever holding does not come back
+    /// farther on. The slice points lie as densely as the mesh's edges, far denser than the
+    /// chordal tolerance asks for on gently curved stretches.
+    fn thin(&self, curve: Curve) -> Result<Vec<SurfacePoint>> {
+        let Curve {
+            points,
+            checked,
+            mut starts,
+        } = curve;
         let n = points.len();
         if n < 3 {
             return Ok(points);
         }
-        // The curve between neighbours too (where a chord dips furthest from it): half-way,
-        // and where neighbours lie far apart (the mesh is coarse where the surface is
-        // gently curved) every half flat spacing, so that a long chord is not checked only
-        // at a few points. `between[i]` starts the points of gap `i` in `middles`.
-        let mut middles: Vec<SurfacePoint> = Vec::with_capacity(n);
-        let mut between: Vec<usize> = Vec::with_capacity(n);
-        for w in points.windows(2) {
-            between.push(middles.len());
-            if w[0].patch != w[1].patch {
-                continue;
-            }
-            let parts = self.gap_checks(&w[0], &w[1]);
-            for k in 1..parts {
-                let t = k as f64 / parts as f64;
-                let uv = [
-                    w[0].uv[0] + t * (w[1].uv[0] - w[0].uv[0]),
-                    w[0].uv[1] + t * (w[1].uv[1] - w[0].uv[1]),
-                ];
-                middles.push(self.point(w[0].patch, uv)?);
-            }
-        }
-        between.push(middles.len());
+        starts.push(checked.len());
         let holds = |i: usize, j: usize| {
             let (a, b) = (&points[i], &points[j]);
             let on = |m: &SurfacePoint| m.patch == a.patch && self.chord_holds(a, b, m, THIN_SHARE);
+            // A gap checked against nothing lies across patches.
             a.patch == b.patch
                 && points[i + 1..j].iter().all(on)
-                && (i..j).all(|g| between[g + 1] > between[g])
-                && middles[between[i]..between[j]].iter().all(on)
+                && (i..j).all(|g| starts[g + 1] > starts[g])
+                && checked[starts[i]..starts[j]].iter().all(on)
         };
         let mut keep = vec![0];
         let mut i = 0;
@@ -1256,14 +1270,15 @@ impl Emit<'_> {
             .clamp(2.0, MAX_GAP_CHECKS as f64) as usize
     }
 
-    /// Adds to `out` the points strictly between `pa` and `pb` (same patch) on the straight
-    /// parameter line between them that bring the chords within the limits.
+    /// Adds to `curve` the points strictly between `pa` and `pb` (same patch, `pa` its last)
+    /// on the straight parameter line between them that bring the chords within the limits,
+    /// and the curve points each chord that holds was checked against.
     fn split(
         &self,
         pa: &SurfacePoint,
         pb: &SurfacePoint,
         depth: usize,
-        out: &mut Vec<SurfacePoint>,
+        curve: &mut Curve,
     ) -> Result<()> {
         if depth == 0 {
             return Ok(());
@@ -1275,20 +1290,24 @@ impl Emit<'_> {
         // points every half flat spacing: where the curvature is uneven along the chord its
         // middle alone can hold while it dips in elsewhere.
         let parts = self.gap_checks(pa, pb);
-        let mut holds = self.chord_holds(pa, pb, &pm, 1.0);
+        let mark = curve.checked.len();
+        curve.checked.push(pm);
+        let mut holds = self.chord_holds(pa, pb, &pm, SPLIT_SHARE);
         for k in (1..parts).filter(|&k| 2 * k != parts) {
             if !holds {
                 break;
             }
             let q = self.point(pa.patch, at(k as f64 / parts as f64))?;
-            holds = self.chord_holds(pa, pb, &q, 1.0);
+            curve.checked.push(q);
+            holds = self.chord_holds(pa, pb, &q, SPLIT_SHARE);
         }
         if holds {
             return Ok(());
         }
-        self.split(pa, &pm, depth - 1, out)?;
-        out.push(pm);
-        self.split(&pm, pb, depth - 1, out)
+        curve.checked.truncate(mark);
+        self.split(pa, &pm, depth - 1, curve)?;
+        curve.push(pm);
+        self.split(&pm, pb, depth - 1, curve)
     }
 
     /// Whether the straight move from `a` to `b` passes within the limits of `m`, a point of
@@ -1331,9 +1350,9 @@ impl Emit<'_> {
         b: &SurfacePoint,
         line: u32,
     ) -> Result<()> {
-        let mut pts = Vec::new();
-        self.split(a, b, CHORD_DEPTH, &mut pts)?;
-        for p in &pts {
+        let mut curve = Curve::default();
+        self.split(a, b, CHORD_DEPTH, &mut curve)?;
+        for p in &curve.points {
             out.link(p, line, Footprint::NONE);
         }
         out.link(b, line, Footprint::NONE);
