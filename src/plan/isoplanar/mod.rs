@@ -48,7 +48,7 @@ const MAX_SLABS: usize = 4096;
 const SLAB_SHARE: f64 = 0.25;
 /// Pass points closer than this share of the slice spacing to the last one checked are not
 /// checked for the cusp beside them (their neighbours' cusps stand for theirs).
-const CHECK_EVERY_SHARE: f64 = 0.25;
+const CHECK_EVERY_SHARE: f64 = 0.5;
 /// How far the neighbouring pass is looked for, in flat-floor spacings.
 const CHECK_REACH_SPACINGS: f64 = 3.0;
 /// Most halvings of a stretch between two slice points while meeting the chordal tolerance.

@@ -8,6 +8,29 @@
 //! function means.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// Hashes an edge key (two vertex indices) by one multiplication: the keys are distinct
+/// integers, not input an adversary chooses, and the default hasher's rounds were a good
+/// part of slicing.
+#[derive(Default)]
+struct EdgeHasher(u64);
+
+impl Hasher for EdgeHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
 
 /// Where a slice crosses a mesh edge: the edge's vertices `a < b`, and `t ∈ [0, 1]` from `a`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,7 +77,8 @@ pub fn slice(all: &[[u32; 3]], triangles: &[u32], value: &[f64], c: f64) -> Vec<
         }
     }
     // Which segments each edge belongs to (one at the mesh boundary, else two).
-    let mut by_edge: HashMap<u64, [u32; 2]> = HashMap::with_capacity(2 * segments.len());
+    let mut by_edge: HashMap<u64, [u32; 2], BuildHasherDefault<EdgeHasher>> =
+        HashMap::with_capacity_and_hasher(2 * segments.len(), Default::default());
     for (s, edges) in segments.iter().enumerate() {
         for &e in edges {
             by_edge
