@@ -30,6 +30,7 @@ fn density(
     side: f64,
     r: f64,
     chordal_mm: f64,
+    max_cell_mm: f64,
 ) -> [Vec<f64>; 2] {
     let n = SIZE_SAMPLES;
     let k = (n - 1) as f64;
@@ -56,7 +57,7 @@ fn density(
                 })
                 .into_iter()
                 .fold(0.0, f64::max);
-            let seg = stepover::chord_step(chordal_mm, kcl);
+            let seg = stepover::chord_step(chordal_mm, kcl).min(max_cell_mm);
             if seg.is_finite() {
                 at[0][a] = at[0][a].max(d.su.norm() / seg);
                 at[1][b] = at[1][b].max(d.sv.norm() / seg);
@@ -153,22 +154,29 @@ pub type VertexVisit<'a> = &'a mut dyn FnMut(usize, &SurfaceDerivs);
 impl ClMesh {
     /// The CL mesh of `model` for a ball of radius `r` (mm) within chordal tolerance
     /// `chordal_mm` of the true offset surface.
-    pub fn new(model: &Model, r: f64, chordal_mm: f64) -> Result<Self> {
-        Self::build(model, r, chordal_mm, None)
+    pub fn new(model: &Model, r: f64, chordal_mm: f64, max_cell_mm: f64) -> Result<Self> {
+        Self::build(model, r, chordal_mm, max_cell_mm, None)
     }
 
     /// [`ClMesh::new`], handing each vertex's index and the surface's derivatives there
     /// (in the patch's parameters) to `each` as the vertex is made: one evaluation serves
     /// the mesh and a caller that needs the curvature at every vertex. The mesh is the
     /// same bit for bit (the point and first derivatives equal those evaluated alone).
-    pub fn new_with(model: &Model, r: f64, chordal_mm: f64, each: VertexVisit) -> Result<Self> {
-        Self::build(model, r, chordal_mm, Some(each))
+    pub fn new_with(
+        model: &Model,
+        r: f64,
+        chordal_mm: f64,
+        max_cell_mm: f64,
+        each: VertexVisit,
+    ) -> Result<Self> {
+        Self::build(model, r, chordal_mm, max_cell_mm, Some(each))
     }
 
     fn build(
         model: &Model,
         r: f64,
         chordal_mm: f64,
+        max_cell_mm: f64,
         mut each: Option<VertexVisit>,
     ) -> Result<Self> {
         let side = model.tool_side();
@@ -180,7 +188,7 @@ impl ClMesh {
         let densities: Vec<[Vec<f64>; 2]> = layout
             .patches
             .iter()
-            .map(|patch| density(patch, surface, side, r, chordal_mm))
+            .map(|patch| density(patch, surface, side, r, chordal_mm, max_cell_mm))
             .collect();
         let lines = |scale: f64| -> Vec<[Vec<f64>; 2]> {
             densities.iter().map(|d| grid_lines(d, scale)).collect()

@@ -87,6 +87,9 @@ const SPLIT_SHARE: f64 = 0.5;
 /// [`MAX_GAP_CHECKS`] times per gap.
 const GAP_CHECK_SPACINGS: f64 = 0.5;
 const MAX_GAP_CHECKS: usize = 256;
+/// Longest CL-mesh cell side, in flat spacings, however gently the surface curves: the
+/// deformation ratio is taken at the mesh's vertices and over its edges.
+const MESH_CELL_SPACINGS: f64 = 1.0;
 /// Most slice points one chord may stand for when thinning.
 const THIN_LOOKAHEAD: usize = 64;
 /// Share of the slicing's progress the pass checks take (after 0.6 of it).
@@ -279,12 +282,18 @@ pub fn slices(
     let mut at_vertex: Vec<Option<(f64, f64)>> = Vec::new();
     let mesh = if opts.isoplanar_deform {
         // The mesh hands over its vertices in order.
-        ClMesh::new_with(model, r, opts.chordal_mm, &mut |k, d| {
-            debug_assert_eq!(k, at_vertex.len(), "vertices in order");
-            at_vertex.push(vertex_ratio(model, &frame, form, r, d));
-        })?
+        ClMesh::new_with(
+            model,
+            r,
+            opts.chordal_mm,
+            MESH_CELL_SPACINGS * spacing,
+            &mut |k, d| {
+                debug_assert_eq!(k, at_vertex.len(), "vertices in order");
+                at_vertex.push(vertex_ratio(model, &frame, form, r, d));
+            },
+        )?
     } else {
-        ClMesh::new(model, r, opts.chordal_mm)?
+        ClMesh::new(model, r, opts.chordal_mm, MESH_CELL_SPACINGS * spacing)?
     };
     if !progress(0.2) {
         return Err(Error::Cancelled);
