@@ -19,15 +19,14 @@ use crate::plan::stepover;
 use crate::surface::{DiffGeom, SurfaceDerivs};
 
 /// The grid cells per unit parameter that `u` and `v` of `patch` ask for, per interval
-/// between neighbouring samples: at each sample the parameter speed over the
-/// chord step whose sagitta is the chordal tolerance on the tighter of the surface's and
-/// the offset's curvature; per interval the largest at its ends and theirs beside (a peak
+/// between neighbouring samples: at each sample the parameter speed over the surface step
+/// whose chord on the offset (and on the surface) keeps within the chordal tolerance, at
+/// most `max_cell_mm`; per interval the largest at its ends and theirs beside (a peak
 /// between samples is not missed by a sample's width), the largest across the other
 /// direction.
 fn density(
     patch: &crate::layout::Patch,
     surface: &crate::surface::Surface,
-    side: f64,
     r: f64,
     chordal_mm: f64,
     max_cell_mm: f64,
@@ -42,21 +41,18 @@ fn density(
             let Some(g) = DiffGeom::try_from_derivs(&d) else {
                 continue;
             };
-            // The offset's principal curvatures, κ / (1 − rκ) with κ seen from the tool's
-            // side (positive concave: there it grows, capped where the offset folds;
-            // convex it shrinks).
+            // The offset's curvature, taken as on the concave side whatever the side:
+            // κ / (1 − rκ), capped where the offset folds (the pipeline lifts the balls
+            // there). Convex, the offset bends less but its ball centres move faster than
+            // the contact point; per step on the surface its sagitta grows as
+            // |κ| (1 + r|κ|), which this bounds up to r|κ| = 1.
             let (k1, k2) = g.principal();
-            let kcl = [k1, k2]
-                .map(|k| {
-                    let k = k * side;
-                    if k * r < 0.5 {
-                        (k / (1.0 - k * r)).abs()
-                    } else {
-                        2.0 * k
-                    }
-                })
-                .into_iter()
-                .fold(0.0, f64::max);
+            let kk = k1.abs().max(k2.abs());
+            let kcl = if kk * r < 0.5 {
+                kk / (1.0 - kk * r)
+            } else {
+                2.0 * kk
+            };
             let seg = stepover::chord_step(chordal_mm, kcl).min(max_cell_mm);
             if seg.is_finite() {
                 at[0][a] = at[0][a].max(d.su.norm() / seg);
@@ -188,7 +184,7 @@ impl ClMesh {
         let densities: Vec<[Vec<f64>; 2]> = layout
             .patches
             .iter()
-            .map(|patch| density(patch, surface, side, r, chordal_mm, max_cell_mm))
+            .map(|patch| density(patch, surface, r, chordal_mm, max_cell_mm))
             .collect();
         let lines = |scale: f64| -> Vec<[Vec<f64>; 2]> {
             densities.iter().map(|d| grid_lines(d, scale)).collect()

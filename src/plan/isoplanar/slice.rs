@@ -28,7 +28,9 @@ impl Hasher for EdgeHasher {
     }
 
     fn finish(&self) -> u64 {
-        self.0
+        // The table picks buckets by the low bits, which the multiplication fills only
+        // from the key's low bits: bring the high ones down.
+        self.0.rotate_left(26)
     }
 }
 
