@@ -256,3 +256,63 @@ impl ClMesh {
             .expect("triangles name existing vertices")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The density's integral over `[a, b]` (piecewise constant per interval).
+    fn integral(d: &[f64], a: f64, b: f64) -> f64 {
+        let w = 1.0 / d.len() as f64;
+        d.iter()
+            .enumerate()
+            .map(|(i, &c)| {
+                let (lo, hi) = (i as f64 * w, (i + 1) as f64 * w);
+                c * (hi.min(b) - lo.max(a)).max(0.0)
+            })
+            .sum()
+    }
+
+    #[test]
+    fn grid_lines_split_the_density_into_equal_shares() {
+        // A peak in the middle, a flat stretch of zero, and an even density.
+        let peaked: Vec<f64> = (0..32)
+            .map(|i| {
+                if (12..16).contains(&i) {
+                    400.0
+                } else if i < 4 {
+                    0.0
+                } else {
+                    10.0
+                }
+            })
+            .collect();
+        let even = vec![37.0; 32];
+        let [u, v] = grid_lines(&[peaked.clone(), even.clone()], 1.0);
+        for (lines, d) in [(&u, &peaked), (&v, &even)] {
+            let total = integral(d, 0.0, 1.0);
+            let n = lines.len() - 1;
+            assert_eq!(n, total.ceil() as usize);
+            assert_eq!((lines[0], lines[n]), (0.0, 1.0));
+            for w in lines.windows(2) {
+                assert!(w[1] > w[0], "{w:?}");
+                // Each cell holds an equal share of the integral, so at most one cell.
+                let share = integral(d, w[0], w[1]);
+                assert!((share - total / n as f64).abs() < 1e-9 * total, "{share}");
+            }
+        }
+        // An even density gives evenly spaced lines.
+        for (i, x) in v.iter().enumerate() {
+            assert!((x - i as f64 / (v.len() - 1) as f64).abs() < 1e-12);
+        }
+        // Nothing asked: the fewest cells, evenly; over the most: the most.
+        assert_eq!(
+            grid_lines(&[vec![0.0; 32], vec![0.0; 32]], 1.0)[0],
+            vec![0.0, 0.5, 1.0]
+        );
+        assert_eq!(
+            grid_lines(&[vec![1e6; 32], even], 1.0)[0].len(),
+            MAX_CELLS + 1
+        );
+    }
+}
