@@ -237,18 +237,19 @@ fn vertex_ratio(
 
 /// The parameter step `(du, dv)` whose tangent `S_u du + S_v dv` is the tangent-plane
 /// projection of `dir` (the metric's inverse); zero where the metric degenerates.
-fn tangent_params(g: &DiffGeom, d: &SurfaceDerivs, dir: &Vector3) -> [f64; 2] {
-    let (a, b) = (d.su.dot(dir), d.sv.dot(dir));
-    let det = g.e * g.g - g.f * g.f;
+fn tangent_params(su: &Vector3, sv: &Vector3, dir: &Vector3) -> [f64; 2] {
+    let (e, f, g) = (su.dot(su), su.dot(sv), sv.dot(sv));
+    let (a, b) = (su.dot(dir), sv.dot(dir));
+    let det = e * g - f * f;
     if !(det > 0.0) {
         return [0.0, 0.0];
     }
-    [(g.g * a - g.f * b) / det, (g.e * b - g.f * a) / det]
+    [(g * a - f * b) / det, (e * b - f * a) / det]
 }
 
 /// Normal curvature of `g` in the tangent direction closest to `dir` (1/mm).
 fn curvature_along(g: &DiffGeom, d: &SurfaceDerivs, dir: &Vector3) -> f64 {
-    let [du, dv] = tangent_params(g, d, dir);
+    let [du, dv] = tangent_params(&d.su, &d.sv, dir);
     if du == 0.0 && dv == 0.0 {
         return 0.0;
     }
@@ -1444,8 +1445,9 @@ impl Emit<'_> {
     fn footprint(&self, pts: &[SurfacePoint], i: usize) -> Footprint {
         let p = &pts[i];
         let patch = &self.model.layout.patches[p.patch as usize];
-        let d = patch.derivs(&self.model.surface, p.uv[0], p.uv[1]);
-        let Some(g) = DiffGeom::try_from_derivs(&d) else {
+        // First derivatives are all it takes (the same as those of `Patch::derivs`).
+        let (_, su, sv) = patch.first_derivs(&self.model.surface, p.uv[0], p.uv[1]);
+        let Some(normal) = crate::surface::diffgeom::unit_normal(&su, &sv) else {
             return Footprint::NONE;
         };
         let same = |j: Option<usize>| j.and_then(|j| pts.get(j)).filter(|q| q.patch == p.patch);
@@ -1460,14 +1462,13 @@ impl Emit<'_> {
             (None, None) => ([0.0; 2], [0.0; 2]),
         };
         // Across: half the allowed side step, in parameters (the metric's inverse).
-        let along = d.su * (b[0] - a[0]) + d.sv * (b[1] - a[1]);
-        let across = g
-            .normal
+        let along = su * (b[0] - a[0]) + sv * (b[1] - a[1]);
+        let across = normal
             .cross(&along)
             .try_normalize(1e-12)
-            .unwrap_or_else(|| d.su.normalize());
+            .unwrap_or_else(|| su.normalize());
         let step = 0.5 * (8.0 * self.r * self.h).sqrt();
-        let c = tangent_params(&g, &d, &(across * step));
+        let c = tangent_params(&su, &sv, &(across * step));
         let mut lo = p.uv;
         let mut hi = p.uv;
         for corner in [a, b] {
