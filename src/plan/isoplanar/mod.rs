@@ -93,8 +93,8 @@ const MESH_CELL_SPACINGS: f64 = 1.0;
 /// Most slice points one chord may stand for when thinning.
 const THIN_LOOKAHEAD: usize = 64;
 /// How far on from the plane being cut (in slice steps) a piece that starts close enough
-/// to be joined on the surface is cut next: the next plane of the even spacing and those
-/// added before it (two steps: Bike.tsm 150 retractions where one gave 203, but the head's
+/// to be joined on the surface is cut next: from a plane of the even spacing, the next one
+/// and those added before it (from an added plane, a step on from it) (two steps: Bike.tsm 150 retractions where one gave 203, but the head's
 /// machining 2.7 % longer and keycap-concave's 3 more retractions; the plane alone: 364).
 const NEAR_PLANES_STEPS: f64 = 1.01;
 /// Share of the chord limits (the smaller of the overcut and the scallop's share) within
@@ -716,6 +716,23 @@ fn on_patch_side(mesh: &ClMesh, p: &SlicePoint) -> bool {
     (ia == ib && (ia == 0 || ia == nu)) || (ja == jb && (ja == 0 || ja == nv))
 }
 
+/// Whether slice point `m` lies within `tol` (mm) of the chord from `a` to `b` (all of one
+/// patch), on the CL mesh and in the patch's parameters (its distance from the straight
+/// parameter line from `a` to `b`, at that line's parameter speed on the mesh).
+fn skippable(a: &SlicePoint, b: &SlicePoint, m: &SlicePoint, tol: f64) -> bool {
+    if dist_to_segment(&m.mesh_cl, &a.mesh_cl, &b.mesh_cl) > tol {
+        return false;
+    }
+    let uv = |p: &SlicePoint| Point3::new(p.uv[0], p.uv[1], 0.0);
+    let (ua, ub) = (uv(a), uv(b));
+    let span = (ub - ua).norm();
+    if !(span > 0.0) {
+        return false;
+    }
+    let speed = (b.mesh_cl - a.mesh_cl).norm() / span;
+    dist_to_segment(&uv(m), &ua, &ub) * speed <= tol
+}
+
 /// Joins open passes of one plane whose ends meet at a patch seam (within `tol` mm), into
 /// longer passes (a pass whose ends meet becomes closed).
 fn join_at_seams(mesh: &ClMesh, mut passes: Vec<Pass>, tol: f64) -> Vec<Pass> {
@@ -1247,11 +1264,14 @@ impl Emit<'_> {
     }
 
     /// The slice points worth evaluating on the surface: from each one picked, the farthest
-    /// on the same patch, at most a flat spacing on, whose mesh chord passes within
-    /// [`PRESELECT_SHARE`] of the chord limits of every mesh point between (the mesh's CL
-    /// points, no surface evaluated). The slice points lie at every mesh edge the plane
-    /// crosses, several per chord the thinning keeps; the refining then checks the picked
-    /// points' chords against the surface as it checked the slice points' own.
+    /// on the same patch (every point between too), at most a flat spacing on, whose chord
+    /// passes within [`PRESELECT_SHARE`] of the chord limits of every point between, both
+    /// on the mesh (its CL points) and in the patch's parameters (the distance from the
+    /// straight parameter line the refining follows, at the chord's parameter speed): no
+    /// surface is evaluated. The slice points lie at every mesh edge the plane crosses,
+    /// several per chord the thinning keeps; the refining then checks the picked points'
+    /// chords against the surface (at their middles, and every half flat spacing on long
+    /// ones), which is where the final path's safety comes from.
     fn preselect(&self, pts: &[SlicePoint]) -> Vec<usize> {
         let n = pts.len();
         if n < 3 {
@@ -1264,17 +1284,17 @@ impl Emit<'_> {
         while i + 1 < n {
             let a = &pts[i];
             let mut held = i + 1;
-            for j in i + 2..n.min(i + 1 + THIN_LOOKAHEAD) {
-                let b = &pts[j];
-                if b.patch != a.patch
-                    || (b.mesh_cl - a.mesh_cl).norm() > reach
-                    || !pts[i + 1..j]
-                        .iter()
-                        .all(|m| dist_to_segment(&m.mesh_cl, &a.mesh_cl, &b.mesh_cl) <= tol)
-                {
-                    break;
+            if pts[held].patch == a.patch {
+                for j in i + 2..n.min(i + 1 + THIN_LOOKAHEAD) {
+                    let b = &pts[j];
+                    if b.patch != a.patch
+                        || (b.mesh_cl - a.mesh_cl).norm() > reach
+                        || !pts[i + 1..j].iter().all(|m| skippable(a, b, m, tol))
+                    {
+                        break;
+                    }
+                    held = j;
                 }
-                held = j;
             }
             picked.push(held);
             i = held;
@@ -1287,8 +1307,9 @@ impl Emit<'_> {
     /// every point between, and of the curve points each gap between was checked against
     /// (where a chord dips furthest from the curve), while the next one's does not, found by
     /// doubling then halving: the farthest such point wherever holding does not come back
-    /// farther on. The slice points lie as densely as the mesh's edges, far denser than the
-    /// chordal tolerance asks for on gently curved stretches.
+    /// farther on. The points picked from the slice ([`Emit::preselect`]) and those the
+    /// refining added lie denser than the chordal tolerance asks for on gently curved
+    /// stretches.
     fn thin(&self, curve: Curve) -> Result<Vec<SurfacePoint>> {
         let Curve {
             points,
