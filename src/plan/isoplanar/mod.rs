@@ -94,8 +94,9 @@ const MESH_CELL_SPACINGS: f64 = 1.0;
 const THIN_LOOKAHEAD: usize = 64;
 /// How far on from the plane being cut (in slice steps) a piece that starts close enough
 /// to be joined on the surface is cut next: from a plane of the even spacing, the next one
-/// and those added before it (from an added plane, a step on from it) (two steps: Bike.tsm 150 retractions where one gave 203, but the head's
-/// machining 2.7 % longer and keycap-concave's 3 more retractions; the plane alone: 364).
+/// and those added before it (from an added plane, a step on from it). Two steps gave
+/// Bike.tsm 150 retractions where one gave 203, but the head 2.7 % longer machining and
+/// keycap-concave 3 more retractions; the plane alone: 364.
 const NEAR_PLANES_STEPS: f64 = 1.01;
 /// Share of the chord limits (the smaller of the overcut and the scallop's share) within
 /// which the slice points' mesh chords must pass for the points between to be left out
@@ -1087,13 +1088,7 @@ pub fn draft(
         // near where one of them ends are cut on the way, not each after a retraction from
         // the far end of its plane).
         let plane = first.plane;
-        let mut window = plane;
-        for c in remaining[k..].iter().flatten().map(|p| p.plane) {
-            if c > plane + NEAR_PLANES_STEPS * s.stats.slice_spacing_mm {
-                break;
-            }
-            window = c;
-        }
+        let window = plane + NEAR_PLANES_STEPS * s.stats.slice_spacing_mm;
         let here = at.map(|a| a.cc);
         let here_cl = at.map(|a| a.cc + a.normal * r);
         let mut best: Option<(f64, usize, bool)> = None;
