@@ -355,7 +355,7 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
         .iter()
         .map(|&(x, y)| [id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)])
         .collect();
-    let (transits, retractions) = corners::select(&order, &ids, &[Crossfeed::U; 4], None);
+    let (transits, retractions) = corners::select(&order, &ids, &[Crossfeed::U; 4], false, None);
     assert_eq!(retractions, 0);
     for w in transits.windows(2) {
         assert_eq!(
@@ -365,7 +365,7 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
         assert_ne!(w[0].start_corner, w[0].finish_corner);
     }
     // Starting the first patch on the only corner it could leave by forces backtracking.
-    let (t2, r2) = corners::select(&order, &ids, &[Crossfeed::U; 4], None);
+    let (t2, r2) = corners::select(&order, &ids, &[Crossfeed::U; 4], false, None);
     assert_eq!((t2, r2), (transits, 0));
 }
 

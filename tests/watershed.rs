@@ -8,7 +8,7 @@ mod support;
 use support::public_tsm;
 use tspath::model::samples;
 use tspath::plan::corners::Crossfeed;
-use tspath::plan::{self, PlanOptions, Strategy};
+use tspath::plan::{self, isoparametric, PlanOptions, Strategy};
 use tspath::verify;
 use tspath::Model;
 
@@ -112,6 +112,45 @@ fn the_direction_rule_reverses_least() {
         println!("{name}: reversals {own} per rectangle, {u} all-U, {v} all-V");
         assert!(own <= u && own <= v, "{name}: {own} vs {u} / {v}");
     }
+}
+
+/// Issue 15: the order's transit corners turned rectangles across to link them without a
+/// retraction, against the direction rule: on bumps-hole (r 1, h 0.01 mm) a 3 × 43 mm
+/// background strip was cut in 174 passes across instead of about 12 along, and the plan
+/// reversed 1 013 times against the multi-rectangle baseline's 628. Every rectangle now keeps
+/// the rule's direction (a retraction where the corners cannot meet), which reverses less
+/// than the baseline there (579).
+#[test]
+fn rectangles_keep_the_rule_direction_and_bumps_hole_reverses_less_than_the_baseline() {
+    let m = samples::load_sample("bumps-hole").unwrap();
+    let plan_with = |strategy| {
+        let o = opts(strategy).with_scallop(0.01);
+        let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
+        let report = planned.report(&o);
+        (planned, report)
+    };
+    let (planned, report) = plan_with(Strategy::Watershed);
+    let cut = m.with_layout(planned.layout.clone().unwrap());
+    let rects = report.rectangles.clone().unwrap();
+    for (view, rect) in isoparametric::patch_views(&cut).iter().zip(&rects) {
+        assert_eq!(
+            rect.crossfeed,
+            isoparametric::preferred_crossfeed(view),
+            "rectangle {}",
+            view.index
+        );
+    }
+    let (_, baseline) = plan_with(Strategy::MultiRectangle);
+    println!(
+        "bumps-hole r 1 h 0.01: watershed {} reversals, {} retractions, {:.0} mm; multi-rectangle {} reversals, {} retractions, {:.0} mm",
+        report.reversals,
+        report.retractions,
+        report.length_mm,
+        baseline.reversals,
+        baseline.retractions,
+        baseline.length_mm
+    );
+    assert!(report.reversals < baseline.reversals);
 }
 
 #[test]

@@ -8,7 +8,10 @@
 //! along a shared side, one at a shared corner: the paper's five situations), preferring the
 //! one that suits the patch's preferred crossfeed direction, and backtracks when a patch has
 //! no usable corner left. When no choice avoids a retraction, the fewest retractions are used
-//! instead and the caller says so.
+//! instead and the caller says so. A strict preference is never traded: where the given
+//! crossfeeds cannot meet at shared corners, the tool retracts instead of turning a patch
+//! across (a long narrow rectangle turned across costs many more passes than one
+//! retraction).
 //!
 //! Corners are numbered 0: `(0,0)`, 1: `(1,0)`, 2: `(1,1)`, 3: `(0,1)` of each patch.
 
@@ -67,14 +70,17 @@ const SEARCH_LIMIT: usize = 1_000_000;
 
 /// Chooses start and finish corners along `order`. `corner_ids[p][k]` identifies corner `k`
 /// of patch `p` (equal ids = the same point of the surface); `preferred[p]` is the patch's
-/// preferred crossfeed; `first_start` fixes the first patch's start corner if given.
-/// Returns the transits and the number of retractions needed.
+/// preferred crossfeed, which a patch leaves to avoid a retraction unless `strict`;
+/// `first_start` fixes the first patch's start corner if given. Returns the transits and
+/// the number of retractions needed.
 pub fn select(
     order: &[usize],
     corner_ids: &[[u32; 4]],
     preferred: &[Crossfeed],
+    strict: bool,
     first_start: Option<u8>,
 ) -> (Vec<Transit>, usize) {
+    let pref = Preferences { preferred, strict };
     if order.is_empty() {
         return (Vec::new(), 0);
     }
@@ -85,7 +91,7 @@ pub fn select(
     };
     for &s0 in &starts {
         let mut chosen = Vec::with_capacity(order.len());
-        if search(order, corner_ids, preferred, 0, s0, &mut chosen, &mut steps) {
+        if search(order, corner_ids, &pref, 0, s0, &mut chosen, &mut steps) {
             let transits = chosen
                 .iter()
                 .enumerate()
@@ -103,7 +109,22 @@ pub fn select(
             break;
         }
     }
-    fewest_retractions(order, corner_ids, preferred, first_start)
+    fewest_retractions(order, corner_ids, &pref, first_start)
+}
+
+/// The crossfeed each patch prefers, and whether it must keep it.
+struct Preferences<'a> {
+    preferred: &'a [Crossfeed],
+    strict: bool,
+}
+
+impl Preferences<'_> {
+    /// Whether a zig-zag of patch `p` from corner `s` to `f` is allowed, and whether it
+    /// misses the patch's preferred crossfeed.
+    fn allows(&self, p: usize, s: u8, f: u8) -> (bool, bool) {
+        let suits = crossfeeds(s, f).contains(&self.preferred[p]);
+        (f != s && (suits || !self.strict), !suits)
+    }
 }
 
 /// Candidate finishing corners of patch `p` started at `s`, towards patch `next`, best first.
@@ -112,11 +133,12 @@ fn candidates(
     s: u8,
     next: Option<usize>,
     ids: &[[u32; 4]],
-    preferred: &[Crossfeed],
+    pref: &Preferences,
 ) -> Vec<(u8, Option<u8>)> {
+    let preferred = pref.preferred;
     let mut out: Vec<(u8, Option<u8>)> = Vec::new();
     for f in 0..4u8 {
-        if f == s {
+        if !pref.allows(p, s, f).0 {
             continue;
         }
         match next {
@@ -136,7 +158,7 @@ fn candidates(
 fn search(
     order: &[usize],
     ids: &[[u32; 4]],
-    preferred: &[Crossfeed],
+    pref: &Preferences,
     i: usize,
     s: u8,
     chosen: &mut Vec<(u8, u8)>,
@@ -148,12 +170,12 @@ fn search(
     }
     let p = order[i];
     let next = order.get(i + 1).copied();
-    for (f, ns) in candidates(p, s, next, ids, preferred) {
+    for (f, ns) in candidates(p, s, next, ids, pref) {
         chosen.push((s, f));
         match ns {
             None => return true,
             Some(ns) => {
-                if search(order, ids, preferred, i + 1, ns, chosen, steps) {
+                if search(order, ids, pref, i + 1, ns, chosen, steps) {
                     return true;
                 }
             }
@@ -168,9 +190,10 @@ fn search(
 fn fewest_retractions(
     order: &[usize],
     ids: &[[u32; 4]],
-    preferred: &[Crossfeed],
+    pref: &Preferences,
     first_start: Option<u8>,
 ) -> (Vec<Transit>, usize) {
+    let preferred = pref.preferred;
     let n = order.len();
     // cost[i][s]: (retractions, missed preferences) to reach patch i starting at corner s.
     let inf = (usize::MAX, usize::MAX);
@@ -188,8 +211,12 @@ fn fewest_retractions(
             if c == inf {
                 continue;
             }
-            for f in (0..4u8).filter(|&f| f != s) {
-                let miss = usize::from(!crossfeeds(s, f).contains(&preferred[p]));
+            for f in 0..4u8 {
+                let (allowed, miss) = pref.allows(p, s, f);
+                if !allowed {
+                    continue;
+                }
+                let miss = usize::from(miss);
                 let shared = (0..4u8).find(|&k| ids[q][k as usize] == ids[p][f as usize]);
                 let options: Vec<(u8, bool)> = match shared {
                     Some(k) => vec![(k, false)],
@@ -224,7 +251,7 @@ fn fewest_retractions(
         n
     ];
     let p_last = order[n - 1];
-    let f_last = candidates(p_last, s_last, None, ids, preferred)[0].0;
+    let f_last = candidates(p_last, s_last, None, ids, pref)[0].0;
     out[n - 1] = Transit {
         patch: p_last,
         start_corner: s_last,
@@ -266,7 +293,7 @@ mod tests {
     #[test]
     fn a_row_of_patches_needs_no_retraction() {
         let ids = grid_ids(4, 1);
-        let (t, r) = select(&[0, 1, 2, 3], &ids, &[Crossfeed::U; 4], Some(0));
+        let (t, r) = select(&[0, 1, 2, 3], &ids, &[Crossfeed::U; 4], false, Some(0));
         assert_eq!(r, 0);
         for w in t.windows(2) {
             assert_eq!(
@@ -282,13 +309,30 @@ mod tests {
         // Patches 0 and 1 share only corner id 4: patch 0 must finish there, so it must not
         // start there; starting patch 0 at its corner 2 (= id 4) must fail and backtrack.
         let ids = vec![[0, 1, 4, 3], [4, 5, 6, 7]];
-        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], None);
+        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, None);
         assert_eq!(r, 0);
         assert_eq!(ids[0][t[0].finish_corner as usize], 4);
-        let (_, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], Some(2));
+        let (_, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, Some(2));
         assert_eq!(
             r, 1,
             "starting at the only shared corner leaves a retraction"
         );
+    }
+
+    #[test]
+    fn a_strict_crossfeed_is_kept_at_the_price_of_a_retraction() {
+        // Patch 0 starts at corner 1, (1, 0), and meets patch 1 only at its corner 2,
+        // (1, 1): finishing there means passes along u (crossfeed V).
+        let ids = vec![[0, 1, 4, 3], [4, 5, 6, 7]];
+        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, Some(1));
+        assert_eq!(
+            (r, t[0].crossfeed, t[0].finish_corner),
+            (0, Crossfeed::V, 2)
+        );
+        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], true, Some(1));
+        assert_eq!(r, 1);
+        assert!(t.iter().all(|x| x.crossfeed == Crossfeed::U
+            && crossfeeds(x.start_corner, x.finish_corner).contains(&Crossfeed::U)));
+        assert!(t[1].retract_before);
     }
 }

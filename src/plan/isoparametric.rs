@@ -624,7 +624,9 @@ pub fn draft(
 }
 
 /// As [`draft`], with each patch's crossfeed given (`crossfeeds`, one per patch; the
-/// option's or the longer side's otherwise), the draft named `strategy`.
+/// option's or the longer side's otherwise), the draft named `strategy`. A crossfeed given
+/// here or in the options is kept even where that costs a retraction; the longer side's
+/// gives way where turning the patch lets the path go on without one.
 pub fn draft_with(
     model: &Model,
     opts: &PlanOptions,
@@ -674,7 +676,9 @@ pub fn draft_with(
     let costs = patch_costs(model);
     let ids = corner_ids(model);
     let order = order::patch_order(&costs, start, finish);
-    let (transits, forced) = corners::select(&order, &ids, &preferred, None);
+    // Crossfeeds given are kept; the longer side's may turn to save a retraction.
+    let strict = crossfeeds.is_some() || opts.crossfeed.is_some();
+    let (transits, forced) = corners::select(&order, &ids, &preferred, strict, None);
     let mut out = DraftBuilder::new(model, opts);
     let mut runs: Vec<PatchRun> = Vec::new();
     let mut worst: f64 = 0.0;
