@@ -149,7 +149,9 @@ fn heuristic(m: &CostMatrix, start: usize, finish: Option<usize>) -> Vec<usize> 
         }
     }
     // Improve: 2-opt reversals and Or-opt moves of 1–3 patches, keeping both ends fixed
-    // when a finish is given (only the start otherwise).
+    // when a finish is given (only the start otherwise). Each move's change of cost is
+    // found from the links it breaks and makes (the matrix is symmetric, so a reversed
+    // stretch costs what it did), and only a move that saves is made.
     let fixed_end = finish.is_some();
     let last_movable = if fixed_end { n - 2 } else { n - 1 };
     let mut improved = true;
@@ -159,10 +161,8 @@ fn heuristic(m: &CostMatrix, start: usize, finish: Option<usize>) -> Vec<usize> 
         rounds += 1;
         for i in 1..=last_movable {
             for j in i + 1..=last_movable {
-                let mut cand = order.clone();
-                cand[i..=j].reverse();
-                if m.path_cost(&cand) < m.path_cost(&order) - 1e-9 {
-                    order = cand;
+                if two_opt_change(m, &order, i, j) < -IMPROVEMENT {
+                    order[i..=j].reverse();
                     improved = true;
                 }
             }
@@ -176,17 +176,16 @@ fn heuristic(m: &CostMatrix, start: usize, finish: Option<usize>) -> Vec<usize> 
                     if j == i {
                         continue;
                     }
-                    let mut cand = order.clone();
-                    let seg: Vec<usize> = cand.drain(i..i + len).collect();
-                    let at = j.min(cand.len());
-                    if fixed_end && at > cand.len() - 1 {
+                    // The stretch is taken out and put back before what is then at `at`.
+                    let at = j.min(n - len);
+                    if fixed_end && at > n - len - 1 {
                         continue;
                     }
-                    for (k, s) in seg.into_iter().enumerate() {
-                        cand.insert(at + k, s);
-                    }
-                    if m.path_cost(&cand) < m.path_cost(&order) - 1e-9 {
-                        order = cand;
+                    if or_opt_change(m, &order, i, len, at) < -IMPROVEMENT {
+                        let seg: Vec<usize> = order.drain(i..i + len).collect();
+                        for (k, s) in seg.into_iter().enumerate() {
+                            order.insert(at + k, s);
+                        }
                         improved = true;
                     }
                 }
@@ -194,6 +193,38 @@ fn heuristic(m: &CostMatrix, start: usize, finish: Option<usize>) -> Vec<usize> 
         }
     }
     order
+}
+
+/// Smallest saving a move must make to be taken (the costs are whole multiples of
+/// [`BOUNDARY_COST`], so any real saving is far above it).
+const IMPROVEMENT: f64 = 1e-9;
+
+/// Change of `order`'s cost when its stretch `i..=j` (`i ≥ 1`) is reversed.
+fn two_opt_change(m: &CostMatrix, order: &[usize], i: usize, j: usize) -> f64 {
+    let mut change = m.get(order[i - 1], order[j]) - m.get(order[i - 1], order[i]);
+    if let Some(&after) = order.get(j + 1) {
+        change += m.get(order[i], after) - m.get(order[j], after);
+    }
+    change
+}
+
+/// Change of `order`'s cost when its stretch of `len` patches from `i` (`i ≥ 1`) is taken
+/// out and put back at index `at` of what remains (`1 ≤ at ≤` the remaining length).
+fn or_opt_change(m: &CostMatrix, order: &[usize], i: usize, len: usize, at: usize) -> f64 {
+    let n = order.len();
+    let (first, last) = (order[i], order[i + len - 1]);
+    // What remains after taking the stretch out, by index.
+    let rest = |k: usize| if k < i { order[k] } else { order[k + len] };
+    let rest_len = n - len;
+    let mut change = -m.get(order[i - 1], first);
+    if i + len < n {
+        change += m.get(order[i - 1], order[i + len]) - m.get(last, order[i + len]);
+    }
+    change += m.get(rest(at - 1), first);
+    if at < rest_len {
+        change += m.get(last, rest(at)) - m.get(rest(at - 1), rest(at));
+    }
+    change
 }
 
 #[cfg(test)]
@@ -231,5 +262,42 @@ mod tests {
         assert_eq!(m.path_cost(&b), 11.0);
         let c = patch_order(&m, 0, Some(11));
         assert_eq!((c[0], c[11]), (0, 11));
+    }
+
+    /// The cost changes computed from the links a move breaks and makes equal the whole
+    /// path's cost after the move minus before, for every move on a scrambled grid.
+    #[test]
+    fn move_changes_equal_the_recomputed_costs() {
+        let m = grid(5, 4);
+        let n = m.n;
+        let order: Vec<usize> = (0..n).map(|k| (k * 7) % n).collect();
+        let before = m.path_cost(&order);
+        for i in 1..n {
+            for j in i + 1..n {
+                let mut cand = order.clone();
+                cand[i..=j].reverse();
+                assert_eq!(
+                    two_opt_change(&m, &order, i, j),
+                    m.path_cost(&cand) - before
+                );
+            }
+            for len in 1..=3 {
+                if i + len > n {
+                    break;
+                }
+                for at in 1..=n - len {
+                    let mut cand = order.clone();
+                    let seg: Vec<usize> = cand.drain(i..i + len).collect();
+                    for (k, s) in seg.into_iter().enumerate() {
+                        cand.insert(at + k, s);
+                    }
+                    assert_eq!(
+                        or_opt_change(&m, &order, i, len, at),
+                        m.path_cost(&cand) - before,
+                        "stretch {i}+{len} to {at}"
+                    );
+                }
+            }
+        }
     }
 }
