@@ -364,7 +364,7 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
         );
         assert_ne!(w[0].start_corner, w[0].finish_corner);
     }
-    // Starting the first patch on the only corner it could leave by forces backtracking.
+    // Same input, same choice.
     let (t2, r2) = corners::select(&order, &ids, &[Crossfeed::U; 4], false, None);
     assert_eq!((t2, r2), (transits, 0));
 }

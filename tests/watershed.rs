@@ -116,7 +116,7 @@ fn the_direction_rule_reverses_least() {
 
 /// Issue 15: the order's transit corners turned rectangles across to link them without a
 /// retraction, against the direction rule: on bumps-hole (r 1, h 0.01 mm) a 3 × 43 mm
-/// background strip was cut in 174 passes across instead of about 12 along, and the plan
+/// background strip was cut in 174 passes across instead of 14 along, and the plan
 /// reversed 1 013 times against the multi-rectangle baseline's 628. Every rectangle now keeps
 /// the rule's direction (a retraction where the corners cannot meet), which reverses less
 /// than the baseline there (579).
@@ -132,7 +132,9 @@ fn rectangles_keep_the_rule_direction_and_bumps_hole_reverses_less_than_the_base
     let (planned, report) = plan_with(Strategy::Watershed);
     let cut = m.with_layout(planned.layout.clone().unwrap());
     let rects = report.rectangles.clone().unwrap();
-    for (view, rect) in isoparametric::patch_views(&cut).iter().zip(&rects) {
+    let views = isoparametric::patch_views(&cut);
+    assert_eq!(rects.len(), views.len());
+    for (view, rect) in views.iter().zip(&rects) {
         assert_eq!(
             rect.crossfeed,
             isoparametric::preferred_crossfeed(view),

@@ -177,8 +177,9 @@ fn heuristic(m: &CostMatrix, start: usize, finish: Option<usize>) -> Vec<usize> 
                         continue;
                     }
                     // The stretch is taken out and put back before what is then at `at`.
-                    let at = j.min(n - len);
-                    if fixed_end && at > n - len - 1 {
+                    let rest_len = order.len() - len;
+                    let at = j.min(rest_len);
+                    if fixed_end && at > rest_len - 1 {
                         continue;
                     }
                     if or_opt_change(m, &order, i, len, at) < -IMPROVEMENT {

@@ -409,7 +409,7 @@ impl Planned {
                 } else if self.isfc.is_some() {
                     "the layout falls into parts no curve can join across a shared side"
                 } else if self.watershed.is_some() {
-                    "rectangles cut in their own directions do not all meet at shared corners"
+                    "the rectangles, each kept to its cutting direction, do not all meet at shared corners"
                 } else {
                     "no patch order and transit corners avoid retractions on this layout"
                 },

@@ -142,8 +142,8 @@ pub fn plan(
         }
         regions
     });
-    // The way each rectangle was cut: its first run's (the order's transits may turn a
-    // rectangle from the rule's direction where that joins it to its neighbours).
+    // The way each rectangle was cut: its first run's (the direction given, which the
+    // transit corners keep).
     let mut cut_ways = crossfeeds.clone();
     for run in planned.toolpath.runs.iter().rev() {
         if let Some(c) = cut_ways.get_mut(run.patch as usize) {
