@@ -364,9 +364,28 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
         );
         assert_ne!(w[0].start_corner, w[0].finish_corner);
     }
-    // Same input, same choice.
-    let (t2, r2) = corners::select(&order, &ids, &[Crossfeed::U; 4], false, None);
-    assert_eq!((t2, r2), (transits, 0));
+    // Strict: every patch keeps the crossfeed given, so its ends differ in u, and the tool
+    // retracts exactly where a patch's start is not the previous finish.
+    for given in [Crossfeed::U, Crossfeed::V] {
+        let (transits, retractions) = corners::select(&order, &ids, &[given; 4], true, None);
+        for t in &transits {
+            assert_eq!(t.crossfeed, given);
+            assert!(corners::crossfeeds(t.start_corner, t.finish_corner).contains(&given));
+        }
+        let apart = transits
+            .windows(2)
+            .filter(|w| {
+                ids[w[0].patch][w[0].finish_corner as usize]
+                    != ids[w[1].patch][w[1].start_corner as usize]
+            })
+            .count();
+        assert_eq!(apart, retractions, "{given:?}");
+        assert_eq!(
+            transits.iter().filter(|t| t.retract_before).count(),
+            retractions
+        );
+        println!("strict {given:?}: {retractions} retraction(s)");
+    }
 }
 
 /// Spacing (mm, along the surface) between the first passes of a single-patch model, and

@@ -8,6 +8,7 @@ mod support;
 use support::public_tsm;
 use tspath::model::samples;
 use tspath::plan::corners::Crossfeed;
+use tspath::plan::isoparametric::ParamSurface;
 use tspath::plan::{self, isoparametric, PlanOptions, Strategy};
 use tspath::verify;
 use tspath::Model;
@@ -119,7 +120,8 @@ fn the_direction_rule_reverses_least() {
 /// background strip was cut in 174 passes across instead of 14 along, and the plan
 /// reversed 1 013 times against the multi-rectangle baseline's 628. Every rectangle now keeps
 /// the rule's direction (a retraction where the corners cannot meet), which reverses less
-/// than the baseline there (579).
+/// than the baseline there (579), and boxes smaller than the ball are left to the
+/// background (542 reversals, 0 retractions, path +1.7 % on the baseline's).
 #[test]
 fn rectangles_keep_the_rule_direction_and_bumps_hole_reverses_less_than_the_baseline() {
     let m = samples::load_sample("bumps-hole").unwrap();
@@ -134,17 +136,49 @@ fn rectangles_keep_the_rule_direction_and_bumps_hole_reverses_less_than_the_base
     let rects = report.rectangles.clone().unwrap();
     let views = isoparametric::patch_views(&cut);
     assert_eq!(rects.len(), views.len());
+    // Sides along the middle iso-lines, on the surface.
+    let side = |view: &isoparametric::PatchView, along_u: bool| {
+        let at = |t: f64| {
+            if along_u {
+                view.subs(t, 0.5)
+            } else {
+                view.subs(0.5, t)
+            }
+        };
+        (1..=64)
+            .map(|k| (at(k as f64 / 64.0) - at((k - 1) as f64 / 64.0)).norm())
+            .sum::<f64>()
+    };
     for (view, rect) in views.iter().zip(&rects) {
-        assert_eq!(
-            rect.crossfeed,
-            isoparametric::preferred_crossfeed(view),
-            "rectangle {}",
-            view.index
-        );
+        let (along_u, along_v) = (side(view, true), side(view, false));
+        // Passes along the longer side (crossfeed V: passes along u), where the sides differ
+        // by more than the planner's three-line estimate can blur.
+        if (along_u - along_v).abs() > 0.01 * along_u.max(along_v) {
+            let longer_u = along_u > along_v;
+            assert_eq!(
+                rect.crossfeed == Crossfeed::V,
+                longer_u,
+                "rectangle {}: {along_u} x {along_v} mm",
+                view.index
+            );
+        }
+        // No feature rectangle is narrower than the ball (PolyBoundingBox left two
+        // 0.9 x 0.5 mm boxes where the convex region juts out of its main box; with them the
+        // region was cut in three, a 0.9 mm wide strip between two halves, and the domain
+        // in 18 rectangles with 5 retractions and 19 569 mm of path).
+        let shorter = along_u.min(along_v);
+        if rect.region.is_some() {
+            assert!(
+                shorter >= 2.0,
+                "feature rectangle {}: {shorter} mm",
+                view.index
+            );
+        }
     }
     let (_, baseline) = plan_with(Strategy::MultiRectangle);
     println!(
-        "bumps-hole r 1 h 0.01: watershed {} reversals, {} retractions, {:.0} mm; multi-rectangle {} reversals, {} retractions, {:.0} mm",
+        "bumps-hole r 1 h 0.01: watershed {} rectangles, {} reversals, {} retractions, {:.0} mm; multi-rectangle {} reversals, {} retractions, {:.0} mm",
+        rects.len(),
         report.reversals,
         report.retractions,
         report.length_mm,
@@ -153,6 +187,7 @@ fn rectangles_keep_the_rule_direction_and_bumps_hole_reverses_less_than_the_base
         baseline.length_mm
     );
     assert!(report.reversals < baseline.reversals);
+    assert!(report.length_mm <= 1.05 * baseline.length_mm);
 }
 
 #[test]

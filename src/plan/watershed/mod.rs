@@ -56,7 +56,9 @@ impl<T: Copy> Grid<T> {
 }
 
 use crate::error::Result;
+use crate::geom::Point3;
 use crate::model::Model;
+use crate::surface::Surface;
 
 /// Which way a feature region curves, seen from the tool.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -181,6 +183,38 @@ impl Features {
             }
         }
         out
+    }
+
+    /// Lengths (mm) on the surface of grid box `b`'s sides once expanded by half a grid
+    /// step (along `s`, along `t`): the grid step's length on the surface, averaged along
+    /// the box's middle row (column) and the point beyond each end, times the steps the
+    /// expanded box spans.
+    pub fn box_sides_mm(&self, surface: &Surface, b: &boxes::GridBox) -> [f64; 2] {
+        let at = &self.map.at;
+        let point = |i: usize, j: usize| {
+            at.at(i, j)
+                .map(|(f, [u, v])| surface.subs(f as usize, u, v))
+        };
+        let along = |n: usize, lo: usize, hi: usize, p: &dyn Fn(usize) -> Option<Point3>| {
+            let (a, z) = (lo.saturating_sub(1), (hi + 1).min(n - 1));
+            let (mut sum, mut steps) = (0.0, 0usize);
+            for k in a..z {
+                if let (Some(x), Some(y)) = (p(k), p(k + 1)) {
+                    sum += (y - x).norm();
+                    steps += 1;
+                }
+            }
+            if steps == 0 {
+                0.0
+            } else {
+                sum / steps as f64 * (hi - lo + 1) as f64
+            }
+        };
+        let (im, jm) = ((b.i0 + b.i1) / 2, (b.j0 + b.j1) / 2);
+        [
+            along(at.nx, b.i0, b.i1, &|i| point(i, jm)),
+            along(at.ny, b.j0, b.j1, &|j| point(im, j)),
+        ]
     }
 
     /// The domain in rectangles: the feature `boxes` (from [`Features::boxes`]) and maximal

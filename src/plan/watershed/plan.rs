@@ -40,6 +40,9 @@ pub struct WatershedStats {
 
 /// Share of the progress bar the draft takes (the pipeline takes the rest).
 const DRAFT_SHARE: f64 = 0.7;
+/// A feature box holding less than this share of its region's largest box (area on the
+/// surface) is cut with the rest of the domain.
+pub const SMALL_BOX_SHARE: f64 = 0.05;
 /// Samples per side of a rectangle for its area.
 const AREA_SAMPLES: usize = 16;
 
@@ -55,7 +58,37 @@ pub fn plan(
     // The feature boxes and rectangles, or for the baseline the domain's rectangles alone.
     let (chart, rects, regions, map_points) = if with_features {
         let found = features(model, map::DEFAULT_PER_UNIT)?;
-        let boxes = found.boxes(DEFAULT_TOR);
+        // A region's boxes besides its largest that hold less than SMALL_BOX_SHARE of its
+        // area are cut with the rest: PolyBoundingBox boxes the few grid steps where a
+        // region juts out of its main box, and their lines split the main box and the
+        // rest into more rectangles (more reversals, retractions where the directions do
+        // not meet) for a sliver of the feature.
+        let mut boxes = found.boxes(DEFAULT_TOR);
+        let areas: Vec<f64> = boxes
+            .iter()
+            .map(|(_, b, _)| {
+                let [s, t] = found.box_sides_mm(&model.surface, b);
+                s * t
+            })
+            .collect();
+        let largest = |label: u32| {
+            boxes
+                .iter()
+                .zip(&areas)
+                .filter(|(b, _)| b.0 == label)
+                .map(|(_, &a)| a)
+                .fold(0.0, f64::max)
+        };
+        let keep: Vec<bool> = boxes
+            .iter()
+            .zip(&areas)
+            .map(|(b, &a)| a >= SMALL_BOX_SHARE * largest(b.0))
+            .collect();
+        let mut k = 0;
+        boxes.retain(|_| {
+            k += 1;
+            keep[k - 1]
+        });
         let rects = found.rectangles(&boxes);
         let regions: Vec<RegionReport> = found
             .features
@@ -142,15 +175,8 @@ pub fn plan(
         }
         regions
     });
-    // The way each rectangle was cut: its first run's (the direction given, which the
-    // transit corners keep).
-    let mut cut_ways = crossfeeds.clone();
-    for run in planned.toolpath.runs.iter().rev() {
-        if let Some(c) = cut_ways.get_mut(run.patch as usize) {
-            *c = run.crossfeed;
-        }
-    }
-    planned.watershed_layer = Some(Layer::of(&cut, &kinds, &cut_ways));
+    // Each rectangle was cut the way given (the transit corners keep a given direction).
+    planned.watershed_layer = Some(Layer::of(&cut, &kinds, &crossfeeds));
     planned.watershed = Some(WatershedStats {
         regions,
         map_points,
