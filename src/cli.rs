@@ -30,7 +30,8 @@ const USAGE: &str = "usage:
               spacing of a quarter of sqrt(8 r h)) up to at most --verify-max-samples
               (default 8 000 000) until its error bound is a quarter of the scallop
               exits with 3 after writing its outputs when the plan has problems (rest area,
-              gouges, scallop over the request, an unproven simulation), listed on stderr
+              gouges, scallop over the request, an unproven simulation), listed on stderr;
+              on a terminal it shows how far planning has got on stderr
   tspath compare MODEL [plan's options] [--strategies a,b,...] [--no-verify]
               [--verify-max-samples N] [--report C.json] [--csv C.csv]
               plans MODEL with every strategy (isoparametric, isfc, watershed,
@@ -489,13 +490,36 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     Ok((m, mach, opts))
 }
 
+/// A progress callback that shows `what` and the percentage done on stderr, on one line
+/// rewritten in place, when stderr is a terminal (nothing otherwise: logs and pipes stay
+/// clean); the line is cleared at 100 %.
+fn terminal_progress(what: &'static str) -> impl FnMut(f64) -> bool {
+    use std::io::{IsTerminal, Write};
+    let shown = std::io::stderr().is_terminal();
+    let mut last = None;
+    move |f: f64| {
+        let percent = (100.0 * f.clamp(0.0, 1.0)).floor() as u32;
+        if shown && last != Some(percent) {
+            last = Some(percent);
+            let mut e = std::io::stderr();
+            let _ = if percent >= 100 {
+                write!(e, "\r{:width$}\r", "", width = what.len() + 8)
+            } else {
+                write!(e, "\r{what} {percent:3} %")
+            };
+            let _ = e.flush();
+        }
+        true
+    }
+}
+
 fn plan(args: &[String]) -> Result<(String, Status)> {
     let a = parse(args, &[SETUP_FLAGS, PLAN_OWN_FLAGS].concat(), PLAN_SWITCHES)?;
     let (m, mach, opts) = plan_setup(&a)?;
     let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
     let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
     let t0 = Instant::now();
-    let planned = plan::plan(&m, &opts, &mut |_| true)?;
+    let planned = plan::plan(&m, &opts, &mut terminal_progress("planning"))?;
     let mut report = planned.report(&opts);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
     report.set_machining_time(&planned.toolpath, &opts, &mach);

@@ -813,3 +813,31 @@ fn air_moves_keep_shank_and_holder_out_of_the_head() {
         );
     }
 }
+
+/// Progress moves while balls are lifted off the surface: on catmark_car.obj (scaled 20
+/// times, r 1 mm) the lifting took minutes at one value, so the page's bar stood still.
+/// On the keycap (lifted where it is tighter than the ball) the isoparametric plan's
+/// progress rises through the lifting's share (0.70 to 0.73 of the whole), never falls,
+/// and ends at 1.
+#[test]
+fn progress_rises_while_balls_are_lifted() {
+    let m = samples::load_sample("keycap-convex").unwrap();
+    let opts = PlanOptions::default();
+    assert!(tspath::plan::gouge::needed(&m, opts.tool_radius_mm));
+    let mut seen = Vec::new();
+    tspath::plan::plan(&m, &opts, &mut |f| {
+        seen.push(f);
+        true
+    })
+    .unwrap();
+    assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+    assert_eq!(seen.last(), Some(&1.0));
+    let mut lifting: Vec<f64> = seen
+        .iter()
+        .copied()
+        .filter(|&f| f > 0.7 + 1e-9 && f < 0.73 - 1e-9)
+        .collect();
+    lifting.dedup();
+    println!("{} progress values while lifting", lifting.len());
+    assert!(lifting.len() >= 5, "{lifting:?}");
+}

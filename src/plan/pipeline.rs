@@ -29,6 +29,9 @@ use crate::verify::{RestRect, Verification};
 /// Share of the overcut limit by which a ball may cut into the surface at a CL point before
 /// the point is lifted (the rest is left to the straight moves between points).
 const GOUGE_LIFT_SHARE: f64 = 0.2;
+/// Share of the pipeline's progress the gouge lifting reports over (it is most of the
+/// work where much of the surface is tighter than the ball).
+const GOUGE_PROGRESS: f64 = 0.1;
 /// Tolerance of the tessellation the air moves are checked against, as a share of the tool
 /// radius (at least the overcut allowed): air moves that do not go straight up lead off
 /// the surface by about twice this first ([`super::air`]).
@@ -113,7 +116,7 @@ pub fn finish(
             r,
             GOUGE_LIFT_SHARE * opts.overcut_mm(),
             &mut left,
-            &mut || progress(0.1),
+            &mut |f| progress(GOUGE_PROGRESS * f),
         )?;
         if !origin.is_empty() {
             let at = |o: u32| (o != u32::MAX).then_some(o as usize);

@@ -80,14 +80,16 @@ const TIGHT_MARGIN: f64 = 0.25;
 /// a convex crease, are checked between their ends: where the ball cuts in on the way, a
 /// lifted cut point is added half-way (and the halves checked again, [`SEGMENT_HALVINGS`] deep). Returns what it did and, when points were added, for
 /// every move of the new path the old move it is (`u32::MAX` for added ones; empty when
-/// nothing was added). `keep_going` is asked every few hundred moves; false cancels.
+/// nothing was added). `keep_going` is told every few hundred moves the share of the work
+/// done (0 to 1: the lifting pass to one half, the straight moves to the whole); false
+/// cancels.
 pub fn lift(
     model: &Model,
     path: &mut Toolpath,
     r: f64,
     tol: f64,
     left: &mut [f64],
-    keep_going: &mut dyn FnMut() -> bool,
+    keep_going: &mut dyn FnMut(f64) -> bool,
 ) -> Result<(GougeStats, Vec<u32>)> {
     let near = Nearest::new(&model.surface);
     let spots = Spots::new(model, &near, r, tol);
@@ -100,8 +102,9 @@ pub fn lift(
     };
     let mut stats = GougeStats::default();
     let mut lifted = vec![false; path.moves.len()];
+    let share = 0.5 / path.moves.len().max(1) as f64;
     for (i, m) in path.moves.iter_mut().enumerate() {
-        if i % CANCEL_EVERY == 0 && !keep_going() {
+        if i % CANCEL_EVERY == 0 && !keep_going(share * i as f64) {
             return Err(Error::Cancelled);
         }
         // Every move ending on the surface, the first cut point after an approach too.
@@ -129,7 +132,7 @@ pub fn lift(
     };
     let mut added: Vec<Vec<(Move, [f64; 2])>> = vec![Vec::new(); n];
     for i in 1..n {
-        if i % CANCEL_EVERY == 0 && !keep_going() {
+        if i % CANCEL_EVERY == 0 && !keep_going(0.5 + share * i as f64) {
             return Err(Error::Cancelled);
         }
         let (a, b) = (&path.moves[i - 1], &path.moves[i]);
