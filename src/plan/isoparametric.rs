@@ -162,30 +162,47 @@ fn predicted_between(s: &dyn ParamSurface, dir: FeedDir, w: f64, dw: f64, r: f64
 
 /// Grid intervals of a step profile across a patch.
 const PROFILE_INTERVALS: usize = 256;
+/// Ratio of the required steps at two neighbouring profile points above which the interval
+/// between them is halved: the step changes fast there (next to a hole's corner, an
+/// extraordinary point) and may dip below both ends between them (by 36 % next to
+/// bumps-hole's hole on a 60 mm patch).
+const PROFILE_REFINE_RATIO: f64 = 1.02;
+/// Most halvings of one profile interval.
+const PROFILE_REFINE_DEPTH: usize = 6;
 
 /// The side step a pass needs as a function of where it is, for one scallop height `h0`.
 /// Side steps scale exactly with `sqrt(h)` (eq. 5), so one profile serves every height the
-/// tuning tries. Between grid points the smaller neighbouring value is used (a lower
-/// envelope, on the safe side).
+/// tuning tries. Between points the smaller neighbouring value is used (a lower envelope,
+/// on the safe side); the points are a uniform grid, halved where neighbours differ by
+/// more than [`PROFILE_REFINE_RATIO`].
 pub struct StepProfile {
+    /// Across-parameter of each point, increasing from 0 to 1.
+    w: Vec<f64>,
     d: Vec<f64>,
     h0: f64,
 }
 
 impl StepProfile {
-    /// Samples the required step on a grid across the patch.
+    /// Samples the required step across the patch.
     pub fn new(s: &dyn ParamSurface, dir: FeedDir, h0: f64, r: f64) -> Result<Self> {
-        let d = (0..=PROFILE_INTERVALS)
-            .map(|i| required_step(s, dir, i as f64 / PROFILE_INTERVALS as f64, h0, r))
-            .collect();
-        Ok(StepProfile { d, h0 })
+        let need = |w: f64| required_step(s, dir, w, h0, r);
+        let mut points = vec![(0.0, need(0.0))];
+        for i in 1..=PROFILE_INTERVALS {
+            let w = i as f64 / PROFILE_INTERVALS as f64;
+            let from = points[points.len() - 1];
+            refine_profile(&need, from, (w, need(w)), PROFILE_REFINE_DEPTH, &mut points);
+        }
+        let (w, d) = points.into_iter().unzip();
+        Ok(StepProfile { w, d, h0 })
     }
 
     /// Required parametric step at `w` for scallop `h`.
     fn step(&self, w: f64, h: f64) -> f64 {
-        let x = (w.clamp(0.0, 1.0) * PROFILE_INTERVALS as f64).min(PROFILE_INTERVALS as f64 - 1e-9);
-        let i = x.floor() as usize;
-        self.d[i].min(self.d[i + 1]) * (h / self.h0).sqrt()
+        let i = self
+            .w
+            .partition_point(|&x| x <= w)
+            .clamp(1, self.w.len() - 1);
+        self.d[i - 1].min(self.d[i]) * (h / self.h0).sqrt()
     }
 
     /// Pass positions for scallop `h`: from 0, each step the smallest needed on the pass,
@@ -202,6 +219,27 @@ impl StepProfile {
             ws.push(w);
         }
         ws
+    }
+}
+
+/// Appends `to` to `points`, after the points between `from` (the last one there) and `to`
+/// that halving the interval up to `depth` times finds where the two ends' required steps
+/// differ by more than [`PROFILE_REFINE_RATIO`].
+fn refine_profile(
+    need: &dyn Fn(f64) -> f64,
+    from: (f64, f64),
+    to: (f64, f64),
+    depth: usize,
+    points: &mut Vec<(f64, f64)>,
+) {
+    let (lo, hi) = (from.1.min(to.1), from.1.max(to.1));
+    if depth > 0 && lo.is_finite() && hi.is_finite() && hi > PROFILE_REFINE_RATIO * lo {
+        let w = 0.5 * (from.0 + to.0);
+        let mid = (w, need(w));
+        refine_profile(need, from, mid, depth - 1, points);
+        refine_profile(need, mid, to, depth - 1, points);
+    } else {
+        points.push(to);
     }
 }
 
