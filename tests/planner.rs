@@ -355,7 +355,8 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
         .iter()
         .map(|&(x, y)| [id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)])
         .collect();
-    let (transits, retractions) = corners::select(&order, &ids, &[Crossfeed::U; 4], false, None);
+    let (transits, retractions) =
+        corners::select(&order, &ids, &[Crossfeed::U; 4], false, None, None);
     assert_eq!(retractions, 0);
     for w in transits.windows(2) {
         assert_eq!(
@@ -367,7 +368,7 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
     // Strict: every patch keeps the crossfeed given, so its ends differ in u, and the tool
     // retracts exactly where a patch's start is not the previous finish.
     for given in [Crossfeed::U, Crossfeed::V] {
-        let (transits, retractions) = corners::select(&order, &ids, &[given; 4], true, None);
+        let (transits, retractions) = corners::select(&order, &ids, &[given; 4], true, None, None);
         for t in &transits {
             assert_eq!(t.crossfeed, given);
             assert!(corners::crossfeeds(t.start_corner, t.finish_corner).contains(&given));

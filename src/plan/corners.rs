@@ -71,18 +71,31 @@ const SEARCH_LIMIT: usize = 1_000_000;
 /// Chooses start and finish corners along `order`. `corner_ids[p][k]` identifies corner `k`
 /// of patch `p` (equal ids = the same point of the surface); `preferred[p]` is the patch's
 /// preferred crossfeed, which a patch leaves to avoid a retraction unless `strict`;
-/// `first_start` fixes the first patch's start corner if given. Returns the transits and
-/// the number of retractions needed.
+/// `natural_odd[p]`, if given, says whether patch `p` cut with its preferred crossfeed
+/// takes an odd number of passes at the scallop asked (it then finishes on the far side
+/// along its passes): among corners equally good otherwise, those that need no pass more
+/// come first. `first_start` fixes the first patch's start corner if given. Returns the
+/// transits and the number of retractions needed.
 pub fn select(
     order: &[usize],
     corner_ids: &[[u32; 4]],
     preferred: &[Crossfeed],
     strict: bool,
+    natural_odd: Option<&[bool]>,
     first_start: Option<u8>,
 ) -> (Vec<Transit>, usize) {
-    let pref = Preferences { preferred, strict };
+    let pref = Preferences {
+        preferred,
+        strict,
+        natural_odd,
+    };
     if order.is_empty() {
         return (Vec::new(), 0);
+    }
+    // With parities to weigh, the dynamic programme finds the best of all corner choices;
+    // the search below takes the first without retractions.
+    if natural_odd.is_some() {
+        return fewest_retractions(order, corner_ids, &pref, first_start);
     }
     let mut steps = 0;
     let starts: Vec<u8> = match first_start {
@@ -112,13 +125,30 @@ pub fn select(
     fewest_retractions(order, corner_ids, &pref, first_start)
 }
 
-/// The crossfeed each patch prefers, and whether it must keep it.
+/// The crossfeed each patch prefers, whether it must keep it, and the parity of its pass
+/// count with it.
 struct Preferences<'a> {
     preferred: &'a [Crossfeed],
     strict: bool,
+    natural_odd: Option<&'a [bool]>,
 }
 
 impl Preferences<'_> {
+    /// True if a zig-zag of patch `p` from corner `s` to `f` needs a pass count of the other
+    /// parity than the patch's natural one (one pass more, at a smaller side step).
+    fn against_parity(&self, p: usize, s: u8, f: u8) -> bool {
+        let Some(natural) = self.natural_odd else {
+            return false;
+        };
+        let ((su, sv), (fu, fv)) = (corner_uv(s), corner_uv(f));
+        let odd = match pick_crossfeed(s, f, self.preferred[p]) {
+            // Passes u = const, cut along v: an odd count ends on the far side in v.
+            Crossfeed::U => fv != sv,
+            Crossfeed::V => fu != su,
+        };
+        odd != natural[p]
+    }
+
     /// Whether a zig-zag of patch `p` from corner `s` to `f` is allowed, and whether it
     /// misses the patch's preferred crossfeed.
     fn allows(&self, p: usize, s: u8, f: u8) -> (bool, bool) {
@@ -150,8 +180,15 @@ fn candidates(
             None => out.push((f, None)),
         }
     }
-    // Corners that suit the preferred crossfeed first (diagonal ones suit both).
-    out.sort_by_key(|&(f, _)| (!crossfeeds(s, f).contains(&preferred[p]), f));
+    // Corners that suit the preferred crossfeed first (diagonal ones suit both), then those
+    // its natural pass count reaches.
+    out.sort_by_key(|&(f, _)| {
+        (
+            !crossfeeds(s, f).contains(&preferred[p]),
+            pref.against_parity(p, s, f),
+            f,
+        )
+    });
     out
 }
 
@@ -186,7 +223,7 @@ fn search(
 }
 
 /// Dynamic programme over the order with the start corner as state: the fewest retractions,
-/// then the most crossfeed preferences met.
+/// then the most crossfeed preferences met, then the fewest patches against their parity.
 fn fewest_retractions(
     order: &[usize],
     ids: &[[u32; 4]],
@@ -195,13 +232,14 @@ fn fewest_retractions(
 ) -> (Vec<Transit>, usize) {
     let preferred = pref.preferred;
     let n = order.len();
-    // cost[i][s]: (retractions, missed preferences) to reach patch i starting at corner s.
-    let inf = (usize::MAX, usize::MAX);
+    // cost[i][s]: (retractions, missed preferences, patches against their parity) to reach
+    // patch i starting at corner s.
+    let inf = (usize::MAX, usize::MAX, usize::MAX);
     let mut cost = vec![[inf; 4]; n];
     let mut back: Vec<[(u8, u8, bool); 4]> = vec![[(0, 0, false); 4]; n];
     for s in 0..4u8 {
         if first_start.is_none_or(|f| f == s) {
-            cost[0][s as usize] = (0, 0);
+            cost[0][s as usize] = (0, 0, 0);
         }
     }
     for i in 0..n - 1 {
@@ -217,13 +255,14 @@ fn fewest_retractions(
                     continue;
                 }
                 let miss = usize::from(miss);
+                let parity = usize::from(pref.against_parity(p, s, f));
                 let shared = (0..4u8).find(|&k| ids[q][k as usize] == ids[p][f as usize]);
                 let options: Vec<(u8, bool)> = match shared {
                     Some(k) => vec![(k, false)],
                     None => (0..4u8).map(|k| (k, true)).collect(),
                 };
                 for (ns, retract) in options {
-                    let nc = (c.0 + usize::from(retract), c.1 + miss);
+                    let nc = (c.0 + usize::from(retract), c.1 + miss, c.2 + parity);
                     if nc < cost[i + 1][ns as usize] {
                         cost[i + 1][ns as usize] = nc;
                         back[i + 1][ns as usize] = (s, f, retract);
@@ -293,7 +332,14 @@ mod tests {
     #[test]
     fn a_row_of_patches_needs_no_retraction() {
         let ids = grid_ids(4, 1);
-        let (t, r) = select(&[0, 1, 2, 3], &ids, &[Crossfeed::U; 4], false, Some(0));
+        let (t, r) = select(
+            &[0, 1, 2, 3],
+            &ids,
+            &[Crossfeed::U; 4],
+            false,
+            None,
+            Some(0),
+        );
         assert_eq!(r, 0);
         for w in t.windows(2) {
             assert_eq!(
@@ -309,10 +355,10 @@ mod tests {
         // Patches 0 and 1 share only corner id 4: patch 0 must finish there, so it must not
         // start there; starting patch 0 at its corner 2 (= id 4) must fail and backtrack.
         let ids = vec![[0, 1, 4, 3], [4, 5, 6, 7]];
-        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, None);
+        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, None, None);
         assert_eq!(r, 0);
         assert_eq!(ids[0][t[0].finish_corner as usize], 4);
-        let (_, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, Some(2));
+        let (_, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, None, Some(2));
         assert_eq!(
             r, 1,
             "starting at the only shared corner leaves a retraction"
@@ -324,15 +370,51 @@ mod tests {
         // Patch 0 starts at corner 1, (1, 0), and meets patch 1 only at its corner 2,
         // (1, 1): finishing there means passes along u (crossfeed V).
         let ids = vec![[0, 1, 4, 3], [4, 5, 6, 7]];
-        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, Some(1));
+        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], false, None, Some(1));
         assert_eq!(
             (r, t[0].crossfeed, t[0].finish_corner),
             (0, Crossfeed::V, 2)
         );
-        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], true, Some(1));
+        let (t, r) = select(&[0, 1], &ids, &[Crossfeed::U; 2], true, None, Some(1));
         assert_eq!(r, 1);
         assert!(t.iter().all(|x| x.crossfeed == Crossfeed::U
             && crossfeeds(x.start_corner, x.finish_corner).contains(&Crossfeed::U)));
         assert!(t[1].retract_before);
+    }
+
+    #[test]
+    fn kept_crossfeeds_finish_where_the_natural_pass_count_leads_unless_that_retracts() {
+        // Two patches side by side, passes along v (crossfeed U): each may finish on
+        // either end of its last pass at no retraction, so each takes its natural parity
+        // (odd: the far side in v).
+        let ids = grid_ids(2, 1);
+        for natural in [[true, false], [false, true], [true, true], [false, false]] {
+            let (t, r) = select(
+                &[0, 1],
+                &ids,
+                &[Crossfeed::U; 2],
+                true,
+                Some(&natural),
+                Some(0),
+            );
+            assert_eq!(r, 0);
+            for x in &t {
+                let ((_, sv), (_, fv)) = (corner_uv(x.start_corner), corner_uv(x.finish_corner));
+                assert_eq!(fv != sv, natural[x.patch], "{natural:?}: {t:?}");
+            }
+        }
+        // Patches meeting at one corner only: patch 0 started at (0, 0) must finish at
+        // (1, 1), an odd count, to go on without a retraction; an even natural count does
+        // not buy a retraction.
+        let ids = vec![[0, 1, 4, 3], [4, 5, 6, 7]];
+        let (t, r) = select(
+            &[0, 1],
+            &ids,
+            &[Crossfeed::U; 2],
+            true,
+            Some(&[false, false]),
+            Some(0),
+        );
+        assert_eq!((r, t[0].finish_corner), (0, 2));
     }
 }

@@ -716,7 +716,41 @@ pub fn draft_with(
     let order = order::patch_order(&costs, start, finish);
     // Crossfeeds given are kept; the longer side's may turn to save a retraction.
     let strict = crossfeeds.is_some() || opts.crossfeed.is_some();
-    let (transits, forced) = corners::select(&order, &ids, &preferred, strict, None);
+    // The scallop budget: most to the side step, the rest to the material a straight move
+    // leaves above a surface that is concave along the feed.
+    // Eq. 5 is the small-h form of the circle geometry and comes out low by about
+    // h/(2r); ask it for correspondingly less.
+    let h_target = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
+    let h_side = h_target / (1.0 + h_target / (2.0 * r));
+    // With the crossfeeds kept, where each patch finishes along its passes is what the
+    // corners still choose: the end its own pass count reaches saves a pass at a smaller
+    // side step.
+    let natural_odd = if strict {
+        let odd = |v: &PatchView, c: Crossfeed| -> Result<bool> {
+            let dir = match c {
+                Crossfeed::U => FeedDir::AlongV,
+                Crossfeed::V => FeedDir::AlongU,
+            };
+            Ok(StepProfile::new(v, dir, h_side, r)?.passes(h_side).len() % 2 == 1)
+        };
+        Some(
+            views
+                .iter()
+                .zip(&preferred)
+                .map(|(v, &c)| odd(v, c))
+                .collect::<Result<Vec<bool>>>()?,
+        )
+    } else {
+        None
+    };
+    let (transits, forced) = corners::select(
+        &order,
+        &ids,
+        &preferred,
+        strict,
+        natural_odd.as_deref(),
+        None,
+    );
     let mut out = DraftBuilder::new(model, opts);
     let mut runs: Vec<PatchRun> = Vec::new();
     let mut worst: f64 = 0.0;
@@ -729,12 +763,6 @@ pub fn draft_with(
             Crossfeed::U => (FeedDir::AlongV, fv != sv),
             Crossfeed::V => (FeedDir::AlongU, fu != su),
         };
-        // The scallop budget: most to the side step, the rest to the material a straight move
-        // leaves above a surface that is concave along the feed.
-        // Eq. 5 is the small-h form of the circle geometry and comes out low by about
-        // h/(2r); ask it for correspondingly less.
-        let h_target = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
-        let h_side = h_target / (1.0 + h_target / (2.0 * r));
         let leave = opts.chordal_mm.min(CHORD_SCALLOP_SHARE * opts.scallop_mm);
         let (ws, h_used, pred) = tuned_passes(view, dir, odd, h_side, r)?;
         // Eq. 5 sees the curvature of each face, not the kinks between faces (a convex
