@@ -490,26 +490,47 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     Ok((m, mach, opts))
 }
 
-/// A progress callback that shows `what` and the percentage done on stderr, on one line
-/// rewritten in place, when stderr is a terminal (nothing otherwise: logs and pipes stay
-/// clean); the line is cleared at 100 %.
-fn terminal_progress(what: &'static str) -> impl FnMut(f64) -> bool {
-    use std::io::{IsTerminal, Write};
-    let shown = std::io::stderr().is_terminal();
-    let mut last = None;
-    move |f: f64| {
+/// How far a long job has got, shown on stderr as `what` and a percentage on one line
+/// rewritten in place when stderr is a terminal (nothing otherwise: logs and pipes stay
+/// clean); the line is cleared when the job is dropped, however it ended.
+struct TerminalProgress {
+    what: &'static str,
+    shown: bool,
+    last: Option<u32>,
+}
+
+impl TerminalProgress {
+    fn new(what: &'static str) -> Self {
+        use std::io::IsTerminal;
+        TerminalProgress {
+            what,
+            shown: std::io::stderr().is_terminal(),
+            last: None,
+        }
+    }
+
+    /// Shows share `f` (0 to 1) done; never cancels.
+    fn update(&mut self, f: f64) -> bool {
+        use std::io::Write;
         let percent = (100.0 * f.clamp(0.0, 1.0)).floor() as u32;
-        if shown && last != Some(percent) {
-            last = Some(percent);
+        if self.shown && self.last != Some(percent) {
+            self.last = Some(percent);
             let mut e = std::io::stderr();
-            let _ = if percent >= 100 {
-                write!(e, "\r{:width$}\r", "", width = what.len() + 8)
-            } else {
-                write!(e, "\r{what} {percent:3} %")
-            };
+            let _ = write!(e, "\r{} {percent:3} %", self.what);
             let _ = e.flush();
         }
         true
+    }
+}
+
+impl Drop for TerminalProgress {
+    fn drop(&mut self) {
+        use std::io::Write;
+        if self.last.is_some() {
+            let mut e = std::io::stderr();
+            let _ = write!(e, "\r{:width$}\r", "", width = self.what.len() + 6);
+            let _ = e.flush();
+        }
     }
 }
 
@@ -519,7 +540,10 @@ fn plan(args: &[String]) -> Result<(String, Status)> {
     let dialect = Dialect::parse(a.value("--dialect").unwrap_or("linuxcnc"))?;
     let units = Units::parse(a.value("--units").unwrap_or("mm"))?;
     let t0 = Instant::now();
-    let planned = plan::plan(&m, &opts, &mut terminal_progress("planning"))?;
+    let mut shown = TerminalProgress::new("planning");
+    let planned = plan::plan(&m, &opts, &mut |f| shown.update(f));
+    drop(shown);
+    let planned = planned?;
     let mut report = planned.report(&opts);
     report.plan_ms = t0.elapsed().as_secs_f64() * 1e3;
     report.set_machining_time(&planned.toolpath, &opts, &mach);

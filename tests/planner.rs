@@ -365,9 +365,10 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
         );
         assert_ne!(w[0].start_corner, w[0].finish_corner);
     }
-    // Strict: every patch keeps the crossfeed given, so its ends differ in u, and the tool
-    // retracts exactly where a patch's start is not the previous finish.
-    for given in [Crossfeed::U, Crossfeed::V] {
+    // Strict: every patch keeps the crossfeed given, so its ends differ across its passes
+    // (in u for crossfeed U, in v for V), and the tool retracts exactly where a patch's
+    // start is not the previous finish: once with crossfeed U on this order, never with V.
+    for (given, expected) in [(Crossfeed::U, 1), (Crossfeed::V, 0)] {
         let (transits, retractions) = corners::select(&order, &ids, &[given; 4], true, None, None);
         for t in &transits {
             assert_eq!(t.crossfeed, given);
@@ -381,6 +382,7 @@ fn a_corner_connection_is_used_when_the_layout_demands_it() {
             })
             .count();
         assert_eq!(apart, retractions, "{given:?}");
+        assert_eq!(retractions, expected, "{given:?}");
         assert_eq!(
             transits.iter().filter(|t| t.retract_before).count(),
             retractions

@@ -11,7 +11,9 @@
 //! instead and the caller says so. A strict preference is never traded: where the given
 //! crossfeeds cannot meet at shared corners, the tool retracts instead of turning a patch
 //! across (a long narrow rectangle turned across costs many more passes than one
-//! retraction).
+//! retraction). With the crossfeeds kept and each patch's natural pass-count parity given,
+//! a dynamic programme over the order chooses instead: the fewest retractions, then the
+//! fewest patches that need a pass more to finish where the links want them.
 //!
 //! Corners are numbered 0: `(0,0)`, 1: `(1,0)`, 2: `(1,1)`, 3: `(0,1)` of each patch.
 
@@ -53,6 +55,17 @@ pub fn crossfeeds(s: u8, f: u8) -> &'static [Crossfeed] {
         (false, true) => &[Crossfeed::V],
         (true, true) => &[Crossfeed::U, Crossfeed::V],
         (false, false) => &[],
+    }
+}
+
+/// True if a zig-zag with crossfeed `c` from corner `s` to `f` has an odd number of passes:
+/// it then ends on the far side along its passes (crossfeed U: passes u = const, cut along
+/// v, so the far side in v).
+pub fn finishes_odd(s: u8, f: u8, c: Crossfeed) -> bool {
+    let ((su, sv), (fu, fv)) = (corner_uv(s), corner_uv(f));
+    match c {
+        Crossfeed::U => fv != sv,
+        Crossfeed::V => fu != su,
     }
 }
 
@@ -140,13 +153,7 @@ impl Preferences<'_> {
         let Some(natural) = self.natural_odd else {
             return false;
         };
-        let ((su, sv), (fu, fv)) = (corner_uv(s), corner_uv(f));
-        let odd = match pick_crossfeed(s, f, self.preferred[p]) {
-            // Passes u = const, cut along v: an odd count ends on the far side in v.
-            Crossfeed::U => fv != sv,
-            Crossfeed::V => fu != su,
-        };
-        odd != natural[p]
+        finishes_odd(s, f, pick_crossfeed(s, f, self.preferred[p])) != natural[p]
     }
 
     /// Whether a zig-zag of patch `p` from corner `s` to `f` is allowed, and whether it

@@ -122,6 +122,15 @@ fn geom_at(s: &dyn ParamSurface, u: f64, v: f64) -> Option<DiffGeom> {
     Some(if s.side() < 0.0 { g.flipped() } else { g })
 }
 
+/// The direction the passes run with crossfeed `c`: crossfeed U steps from pass to pass in
+/// u, the passes u = const cut along v.
+fn feed_dir(c: Crossfeed) -> FeedDir {
+    match c {
+        Crossfeed::U => FeedDir::AlongV,
+        Crossfeed::V => FeedDir::AlongU,
+    }
+}
+
 /// Point on the pass at fixed `w` (the across-parameter), moving parameter `t`.
 fn at(dir: FeedDir, t: f64, w: f64) -> (f64, f64) {
     match dir {
@@ -232,8 +241,10 @@ fn refine_profile(
     depth: usize,
     points: &mut Vec<(f64, f64)>,
 ) {
+    // An end where no step could be found (no tangent plane along that pass) against a
+    // finite one differs too: halving finds where the surface begins to need one.
     let (lo, hi) = (from.1.min(to.1), from.1.max(to.1));
-    if depth > 0 && lo.is_finite() && hi.is_finite() && hi > PROFILE_REFINE_RATIO * lo {
+    if depth > 0 && lo.is_finite() && !(hi <= PROFILE_REFINE_RATIO * lo) {
         let w = 0.5 * (from.0 + to.0);
         let mid = (w, need(w));
         refine_profile(need, from, mid, depth - 1, points);
@@ -275,11 +286,11 @@ pub fn pass_positions(
 fn tuned_passes(
     s: &dyn ParamSurface,
     dir: FeedDir,
+    profile: &StepProfile,
     odd: bool,
     h: f64,
     r: f64,
 ) -> Result<(Vec<f64>, f64, f64)> {
-    let profile = StepProfile::new(s, dir, h, r)?;
     let done = |ws: Vec<f64>, hh: f64| {
         let pred = predicted(s, dir, &ws, r);
         Ok((ws, hh, pred))
@@ -725,24 +736,24 @@ pub fn draft_with(
     // With the crossfeeds kept, where each patch finishes along its passes is what the
     // corners still choose: the end its own pass count reaches saves a pass at a smaller
     // side step.
-    let natural_odd = if strict {
-        let odd = |v: &PatchView, c: Crossfeed| -> Result<bool> {
-            let dir = match c {
-                Crossfeed::U => FeedDir::AlongV,
-                Crossfeed::V => FeedDir::AlongU,
-            };
-            Ok(StepProfile::new(v, dir, h_side, r)?.passes(h_side).len() % 2 == 1)
-        };
-        Some(
-            views
-                .iter()
-                .zip(&preferred)
-                .map(|(v, &c)| odd(v, c))
-                .collect::<Result<Vec<bool>>>()?,
-        )
+    // (Each patch's profile, made for that, then serves its passes: kept crossfeeds are
+    // the ones cut.)
+    let mut profiles: Vec<Option<StepProfile>> = if strict {
+        views
+            .iter()
+            .zip(&preferred)
+            .map(|(v, &c)| StepProfile::new(v, feed_dir(c), h_side, r).map(Some))
+            .collect::<Result<_>>()?
     } else {
-        None
+        views.iter().map(|_| None).collect()
     };
+    let natural_odd: Option<Vec<bool>> = strict.then(|| {
+        profiles
+            .iter()
+            .flatten()
+            .map(|p| p.passes(h_side).len() % 2 == 1)
+            .collect()
+    });
     let (transits, forced) = corners::select(
         &order,
         &ids,
@@ -757,14 +768,14 @@ pub fn draft_with(
     for (k, tr) in transits.iter().enumerate() {
         let view = &views[tr.patch];
         let (su, sv) = corners::corner_uv(tr.start_corner);
-        let (fu, fv) = corners::corner_uv(tr.finish_corner);
-        let (dir, odd) = match tr.crossfeed {
-            // Passes u = const step in u, cutting along v.
-            Crossfeed::U => (FeedDir::AlongV, fv != sv),
-            Crossfeed::V => (FeedDir::AlongU, fu != su),
-        };
+        let dir = feed_dir(tr.crossfeed);
+        let odd = corners::finishes_odd(tr.start_corner, tr.finish_corner, tr.crossfeed);
         let leave = opts.chordal_mm.min(CHORD_SCALLOP_SHARE * opts.scallop_mm);
-        let (ws, h_used, pred) = tuned_passes(view, dir, odd, h_side, r)?;
+        let profile = match profiles[tr.patch].take() {
+            Some(p) => p,
+            None => StepProfile::new(view, dir, h_side, r)?,
+        };
+        let (ws, h_used, pred) = tuned_passes(view, dir, &profile, odd, h_side, r)?;
         // Eq. 5 sees the curvature of each face, not the kinks between faces (a convex
         // crease between two passes widens their cusp by about r times its angle): the
         // cusps between the passes are computed from the two balls and split where too high.

@@ -23,7 +23,8 @@ pub struct RegionReport {
     pub kind: FeatureKind,
     /// Area of its rectangles on the surface (mm²).
     pub area_mm2: f64,
-    /// Boxes PolyBoundingBox made of it.
+    /// Boxes PolyBoundingBox made of it that are cut as the feature's (those holding less
+    /// than [`SMALL_BOX_SHARE`] of its largest box are cut with the rest).
     pub boxes: usize,
 }
 
@@ -58,11 +59,11 @@ pub fn plan(
     // The feature boxes and rectangles, or for the baseline the domain's rectangles alone.
     let (chart, rects, regions, map_points) = if with_features {
         let found = features(model, map::DEFAULT_PER_UNIT)?;
-        // A region's boxes besides its largest that hold less than SMALL_BOX_SHARE of its
-        // area are cut with the rest: PolyBoundingBox boxes the few grid steps where a
-        // region juts out of its main box, and their lines split the main box and the
-        // rest into more rectangles (more reversals, retractions where the directions do
-        // not meet) for a sliver of the feature.
+        // A region's boxes that hold less than SMALL_BOX_SHARE of its largest box are cut
+        // with the rest: PolyBoundingBox boxes the few grid steps where a region juts out
+        // of its main box, and their lines split the main box and the rest into more
+        // rectangles (more reversals, retractions where the directions do not meet) for a
+        // sliver of the feature.
         let mut boxes = found.boxes(DEFAULT_TOR);
         let areas: Vec<f64> = boxes
             .iter()
@@ -71,24 +72,18 @@ pub fn plan(
                 s * t
             })
             .collect();
-        let largest = |label: u32| {
-            boxes
-                .iter()
-                .zip(&areas)
-                .filter(|(b, _)| b.0 == label)
-                .map(|(_, &a)| a)
-                .fold(0.0, f64::max)
-        };
-        let keep: Vec<bool> = boxes
+        let mut largest = vec![0.0f64; found.features.len() + 1];
+        for ((label, _, _), &a) in boxes.iter().zip(&areas) {
+            largest[*label as usize] = largest[*label as usize].max(a);
+        }
+        // (A box whose area is not a number is kept.)
+        let mut small = boxes
             .iter()
             .zip(&areas)
-            .map(|(b, &a)| a >= SMALL_BOX_SHARE * largest(b.0))
-            .collect();
-        let mut k = 0;
-        boxes.retain(|_| {
-            k += 1;
-            keep[k - 1]
-        });
+            .map(|((label, _, _), &a)| a < SMALL_BOX_SHARE * largest[*label as usize])
+            .collect::<Vec<bool>>()
+            .into_iter();
+        boxes.retain(|_| !small.next().unwrap_or(false));
         let rects = found.rectangles(&boxes);
         let regions: Vec<RegionReport> = found
             .features
