@@ -820,8 +820,8 @@ fn air_moves_keep_shank_and_holder_out_of_the_head() {
 /// Progress moves while balls are lifted off the surface: on catmark_car.obj (scaled 20
 /// times, r 1 mm) the lifting took minutes at one value, so the page's bar stood still.
 /// On the keycap (lifted where it is tighter than the ball) the isoparametric plan's
-/// progress rises through the lifting's share (0.70 to 0.73 of the whole), never falls,
-/// and ends at 1.
+/// progress rises through the lifting's share (0.70 to 0.73 of the whole) and the
+/// measuring of the footprints near lifted balls (to 0.745), never falls, and ends at 1.
 #[test]
 fn progress_rises_while_balls_are_lifted() {
     let m = samples::load_sample("keycap-convex").unwrap();
@@ -843,6 +843,15 @@ fn progress_rises_while_balls_are_lifted() {
     lifting.dedup();
     println!("{} progress values while lifting", lifting.len());
     assert!(lifting.len() >= 5, "{lifting:?}");
+    // Then the footprints near lifted balls are measured (0.73 to 0.745).
+    let mut measuring: Vec<f64> = seen
+        .iter()
+        .copied()
+        .filter(|&f| f > 0.73 + 1e-9 && f < 0.745 - 1e-9)
+        .collect();
+    measuring.dedup();
+    println!("{} while measuring near them", measuring.len());
+    assert!(measuring.len() >= 2, "{measuring:?}");
 }
 
 /// The side-step profile is refined where the required step changes fast: sampled on 256

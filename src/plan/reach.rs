@@ -280,6 +280,9 @@ const PATTERN: [(f64, f64); 8] = [
     (-1.0, 1.0),
 ];
 
+/// Footprints measured between two progress reports (and checks for cancellation).
+const PROGRESS_EVERY: usize = 32;
+
 /// Which cut points leave more than `scallop_mm` in their footprint because balls were lifted
 /// near them: a ball lifted clear of a crease or a tight concave spot leaves more at its
 /// contact point (`left`) and widens the cusps to the passes beside it, which the side steps
@@ -287,13 +290,16 @@ const PATTERN: [(f64, f64); 8] = [
 /// with the swept balls of `path` (the draft after lifting: the cuts as moves on the surface),
 /// as the cutting simulation measures them. Returns per move whether more than the scallop
 /// is left in its footprint ([`shares_left`] measures how much, on the final path).
+/// `progress` is told the share of the footprints measured every few dozen; false cancels
+/// (`None`).
 pub fn tight_near_lifts(
     model: &Model,
     path: &Toolpath,
     footprints: &[Footprint],
     left: &[f64],
     scallop_mm: f64,
-) -> Vec<bool> {
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Option<Vec<bool>> {
     let n = path.moves.len();
     let mut tight = vec![false; n];
     let r = path.tool_radius_mm;
@@ -301,7 +307,7 @@ pub fn tight_near_lifts(
         .filter(|&i| left.get(i).is_some_and(|&l| l > 0.0) && path.moves[i].kind.on_surface())
         .collect();
     if lifted.is_empty() {
-        return tight;
+        return Some(tight);
     }
     // How far a footprint reaches from its contact point (mm).
     let extent = |i: usize| -> f64 {
@@ -388,7 +394,7 @@ pub fn tight_near_lifts(
         })
         .collect();
     if capsules.is_empty() {
-        return tight;
+        return Some(tight);
     }
     let box_ = crate::geom::Aabb { min: lo, max: hi };
     let index = CapsuleIndex::build(&capsules, r, &box_, 0.5 * r);
@@ -399,7 +405,11 @@ pub fn tight_near_lifts(
         unreached_mm: f64::NEG_INFINITY,
     };
     let near_mm = probe.probe.near_mm();
-    for (i, own) in candidates {
+    let share = 1.0 / candidates.len().max(1) as f64;
+    for (k, (i, own)) in candidates.into_iter().enumerate() {
+        if k % PROGRESS_EVERY == 0 && !progress(share * k as f64) {
+            return None;
+        }
         let f = footprints[i];
         // Every sample of the footprint tests only the balls near it.
         probe
@@ -524,7 +534,7 @@ pub fn tight_near_lifts(
         }
         tight[i] = top > scallop_mm;
     }
-    tight
+    Some(tight)
 }
 
 /// Measures the material swept balls leave at points of footprints.
