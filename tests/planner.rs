@@ -835,21 +835,21 @@ fn progress_rises_while_balls_are_lifted() {
     .unwrap();
     assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
     assert_eq!(seen.last(), Some(&1.0));
-    let mut lifting: Vec<f64> = seen
-        .iter()
-        .copied()
-        .filter(|&f| f > 0.7 + 1e-9 && f < 0.73 - 1e-9)
-        .collect();
-    lifting.dedup();
+    // Distinct values strictly inside (lo, hi).
+    let inside = |lo: f64, hi: f64| {
+        let mut v: Vec<f64> = seen
+            .iter()
+            .copied()
+            .filter(|&f| f > lo + 1e-9 && f < hi - 1e-9)
+            .collect();
+        v.dedup();
+        v
+    };
+    let lifting = inside(0.7, 0.73);
     println!("{} progress values while lifting", lifting.len());
     assert!(lifting.len() >= 5, "{lifting:?}");
     // Then the footprints near lifted balls are measured (0.73 to 0.745).
-    let mut measuring: Vec<f64> = seen
-        .iter()
-        .copied()
-        .filter(|&f| f > 0.73 + 1e-9 && f < 0.745 - 1e-9)
-        .collect();
-    measuring.dedup();
+    let measuring = inside(0.73, 0.745);
     println!("{} while measuring near them", measuring.len());
     assert!(measuring.len() >= 2, "{measuring:?}");
 }
