@@ -282,6 +282,126 @@ const PATTERN: [(f64, f64); 8] = [
 
 /// Footprints measured between two progress reports (and checks for cancellation).
 const PROGRESS_EVERY: usize = 32;
+/// Cut points looked at between two checks for cancellation while finding those near lifted
+/// ones.
+const CANCEL_EVERY: usize = 4096;
+/// Most lifted points a cut point is compared with on average in a grid of cells a reach
+/// wide before a finer grid is used (where many lifted balls leave wide footprints).
+const COARSE_WORK_PER_MOVE: usize = 64;
+/// The finer grid's cells: twice the median footprint reach of the lifted points, and no
+/// fewer than 1/this of the reach (so one footprint spans a bounded number of cells).
+const FINE_CELLS_PER_REACH: f64 = 32.0;
+
+/// The cut points whose footprints may touch a lifted point's, each with its footprint's
+/// `extent` (mm): contacts within `reach` of a lifted point's contact whose footprints'
+/// spheres (round the contact points, through the far corners; the lifted ones' radii
+/// `lifted_extent`) meet. A hash grid of cells a reach wide lists every lifted contact in its
+/// cell and the 26 around it, so a cut point needs one look-up; where that would compare each
+/// cut point with many lifted ones (a ball larger than much of the model: most of its cuts
+/// are lifted, some of their footprints far from their contacts), each lifted footprint's
+/// sphere is listed in the cells of a finer grid its box meets, and each cut point looks in
+/// the cells its own sphere's box meets (two spheres that meet have boxes that share a
+/// cell). `keep_going` is asked every few thousand cut points; false cancels (`None`).
+#[allow(clippy::too_many_arguments)]
+fn touching_lifted(
+    coarse_work_per_move: usize,
+    path: &Toolpath,
+    footprints: &[Footprint],
+    lifted: &[usize],
+    lifted_extent: &[f64],
+    reach: f64,
+    extent: &dyn Fn(usize) -> f64,
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Option<Vec<(usize, f64)>> {
+    let contact = |k: usize| path.moves[lifted[k]].cc_point;
+    let touches = |c: &Point3, own: f64, k: usize| {
+        let d = (contact(k) - c).norm();
+        d <= reach && d <= (own + lifted_extent[k]) * (1.0 + TOUCH_SLACK)
+    };
+    let cuts = || {
+        path.moves
+            .iter()
+            .enumerate()
+            .filter(|(i, m)| m.kind.on_surface() && !footprints[*i].is_none())
+    };
+    type Grid = std::collections::HashMap<[i64; 3], Vec<usize>>;
+    let key = |p: &[f64; 3], cell: f64| p.map(|x| (x / cell).floor() as i64);
+    let mut out = Vec::new();
+    // Each lifted contact in its cell (a reach wide) and the 26 around it.
+    let cell = reach.max(1e-9);
+    let mut grid: Grid = Default::default();
+    for k in 0..lifted.len() {
+        let c = key(&contact(k).into(), cell);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    grid.entry([c[0] + dx, c[1] + dy, c[2] + dz])
+                        .or_default()
+                        .push(k);
+                }
+            }
+        }
+    }
+    let listed = |m: &Move| grid.get(&key(&m.cc_point.into(), cell));
+    let work: usize = cuts().map(|(_, m)| listed(m).map_or(0, Vec::len)).sum();
+    if work <= coarse_work_per_move.saturating_mul(path.moves.len()) {
+        for (n, (i, m)) in cuts().enumerate() {
+            if n % CANCEL_EVERY == 0 && !keep_going() {
+                return None;
+            }
+            let Some(ks) = listed(m) else {
+                continue;
+            };
+            // The extent only where a lifted contact lies within reach.
+            let c = m.cc_point;
+            if !ks.iter().any(|&k| (contact(k) - c).norm() <= reach) {
+                continue;
+            }
+            let own = extent(i);
+            if ks.iter().any(|&k| touches(&c, own, k)) {
+                out.push((i, own));
+            }
+        }
+        return Some(out);
+    }
+    drop(grid);
+    // The finer grid: each lifted footprint's sphere in the cells its box meets (widened by
+    // a little for rounding).
+    let radius = |e: f64| e * (1.0 + TOUCH_SLACK) * (1.0 + 1e-9);
+    let mut spheres: Vec<f64> = lifted_extent.iter().map(|&e| radius(e)).collect();
+    let mid = spheres.len() / 2;
+    let median = *spheres.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let fine = (2.0 * median).max(reach / FINE_CELLS_PER_REACH).max(1e-9);
+    let cells = |c: &Point3, r: f64| {
+        let (lo, hi) = (
+            key(&[c.x - r, c.y - r, c.z - r], fine),
+            key(&[c.x + r, c.y + r, c.z + r], fine),
+        );
+        (lo[0]..=hi[0]).flat_map(move |x| {
+            (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
+        })
+    };
+    let mut grid: Grid = Default::default();
+    for k in 0..lifted.len() {
+        for at in cells(&contact(k), radius(lifted_extent[k])) {
+            grid.entry(at).or_default().push(k);
+        }
+    }
+    for (n, (i, m)) in cuts().enumerate() {
+        if n % CANCEL_EVERY == 0 && !keep_going() {
+            return None;
+        }
+        let (c, own) = (m.cc_point, extent(i));
+        let hit = cells(&c, radius(own).min(reach)).any(|at| {
+            grid.get(&at)
+                .is_some_and(|ks| ks.iter().any(|&k| touches(&c, own, k)))
+        });
+        if hit {
+            out.push((i, own));
+        }
+    }
+    Some(out)
+}
 
 /// Which cut points leave more than `scallop_mm` in their footprint because balls were lifted
 /// near them: a ball lifted clear of a crease or a tight concave spot leaves more at its
@@ -325,53 +445,16 @@ pub fn tight_near_lifts(
     };
     let lifted_extent: Vec<f64> = lifted.iter().map(|&i| extent(i)).collect();
     let reach = 2.0 * lifted_extent.iter().fold(0.0f64, |a, &b| a.max(b)) + r;
-    // Candidates: cut points whose contact lies within reach of a lifted one (a hash grid of
-    // the lifted contacts), then those whose footprint may touch a lifted point's.
-    let cell = reach.max(1e-9);
-    let key = |p: &Point3| [p.x, p.y, p.z].map(|x| (x / cell).floor() as i64);
-    // Each lifted contact is listed in its cell and the 26 around it, so a cut point needs
-    // one look-up (cut points outnumber lifted ones by hundreds).
-    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
-    for (k, &i) in lifted.iter().enumerate() {
-        let c = key(&path.moves[i].cc_point);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    grid.entry([c[0] + dx, c[1] + dy, c[2] + dz])
-                        .or_default()
-                        .push(k);
-                }
-            }
-        }
-    }
-    let mut candidates = Vec::new();
-    let mut near: Vec<usize> = Vec::new();
-    for (i, m) in path.moves.iter().enumerate() {
-        if !m.kind.on_surface() || footprints[i].is_none() {
-            continue;
-        }
-        // Lifted points whose contact is within reach, then whether the two footprints'
-        // spheres (round the contact points, through the far corners) meet.
-        near.clear();
-        if let Some(ks) = grid.get(&key(&m.cc_point)) {
-            near.extend(
-                ks.iter()
-                    .copied()
-                    .filter(|&k| (path.moves[lifted[k]].cc_point - m.cc_point).norm() <= reach),
-            );
-        }
-        if near.is_empty() {
-            continue;
-        }
-        let own = extent(i);
-        let touches = near.iter().any(|&k| {
-            (path.moves[lifted[k]].cc_point - m.cc_point).norm()
-                <= (own + lifted_extent[k]) * (1.0 + TOUCH_SLACK)
-        });
-        if touches {
-            candidates.push((i, own));
-        }
-    }
+    let candidates = touching_lifted(
+        COARSE_WORK_PER_MOVE,
+        path,
+        footprints,
+        &lifted,
+        &lifted_extent,
+        reach,
+        &extent,
+        &mut || progress(0.0),
+    )?;
     // The swept balls near the candidates.
     let mut region = crate::geom::Aabb::empty();
     for &(i, _) in &candidates {
@@ -1008,6 +1091,90 @@ pub fn rest(
 mod tests {
     use super::*;
     use crate::geom::Vector3;
+
+    /// The cut points found near lifted ones by the grid a reach wide and by the finer grid
+    /// of footprint spheres are the same, and the same as comparing every pair: on 4 000 cut
+    /// points scattered over a 20 mm cube, a fifth lifted, with footprints mostly 0.2 mm
+    /// across and a few up to 6 mm (a ball lifted far from its footprint), and with the
+    /// footprints all small.
+    #[test]
+    fn both_grids_find_the_cut_points_touching_lifted_footprints() {
+        let mut next = crate::testing::uniform(12_345);
+        for wide in [true, false] {
+            let n = 4000;
+            let moves: Vec<Move> = (0..n)
+                .map(|_| {
+                    let mut m = mv(MoveKind::Feed, 0.0);
+                    m.cc_point = Point3::new(20.0 * next(), 20.0 * next(), 20.0 * next());
+                    m
+                })
+                .collect();
+            let extents: Vec<f64> = (0..n)
+                .map(|_| {
+                    let e = 0.1 + 0.1 * next();
+                    if wide && next() < 0.02 {
+                        6.0 * next()
+                    } else {
+                        e
+                    }
+                })
+                .collect();
+            let footprints: Vec<Footprint> = (0..n)
+                .map(|i| {
+                    if i % 7 == 3 {
+                        Footprint::NONE
+                    } else {
+                        Footprint {
+                            patch: 0,
+                            rect: [0.0, 1.0, 0.0, 1.0],
+                        }
+                    }
+                })
+                .collect();
+            let lifted: Vec<usize> = (0..n).filter(|i| i % 5 == 0 && i % 7 != 3).collect();
+            let lifted_extent: Vec<f64> = lifted.iter().map(|&i| extents[i]).collect();
+            let reach = 2.0 * lifted_extent.iter().fold(0.0f64, |a, &b| a.max(b)) + 0.5;
+            let path = Toolpath {
+                tool_radius_mm: 0.5,
+                moves,
+                max_predicted_scallop_mm: 0.0,
+                runs: Vec::new(),
+                params: Vec::new(),
+            };
+            let extent = |i: usize| extents[i];
+            let find = |work: usize| {
+                touching_lifted(
+                    work,
+                    &path,
+                    &footprints,
+                    &lifted,
+                    &lifted_extent,
+                    reach,
+                    &extent,
+                    &mut || true,
+                )
+                .unwrap()
+            };
+            let (coarse, fine) = (find(usize::MAX), find(0));
+            let every_pair: Vec<(usize, f64)> = (0..n)
+                .filter(|&i| !footprints[i].is_none())
+                .filter(|&i| {
+                    lifted.iter().zip(&lifted_extent).any(|(&k, &e)| {
+                        let d = (path.moves[k].cc_point - path.moves[i].cc_point).norm();
+                        d <= reach && d <= (extents[i] + e) * (1.0 + TOUCH_SLACK)
+                    })
+                })
+                .map(|i| (i, extents[i]))
+                .collect();
+            println!(
+                "wide footprints {wide}: {} of {n} cut points touch a lifted footprint",
+                every_pair.len()
+            );
+            assert!(every_pair.len() > 100 && every_pair.len() < n / 2);
+            assert_eq!(coarse, every_pair, "the grid a reach wide");
+            assert_eq!(fine, every_pair, "the finer grid");
+        }
+    }
 
     fn mv(kind: MoveKind, x: f64) -> Move {
         Move {

@@ -44,6 +44,15 @@ pub struct GougeStats {
 const PLUNGE_LIFT_COS: f64 = 0.5;
 /// Lifting rounds per CL point (each moves it away from the then nearest point).
 const LIFT_ROUNDS: usize = 8;
+/// A lift stops when its depth is more than this share of the depth this many rounds
+/// before (it is not getting clearer: the ball is in a slot narrower than it, between three
+/// or more walls).
+const STUCK_SHARE: f64 = 0.5;
+const STUCK_ROUNDS: usize = 2;
+/// Least angle between two walls a lifted ball touches, or between one and the other's
+/// opposite, for a step to clear both at once (as the cosine between their normals; 2.6°):
+/// nearer parallel, one wall's step serves.
+const TWO_WALLS_COS: f64 = 0.999;
 /// Moves between two checks for cancellation.
 const CANCEL_EVERY: usize = 256;
 
@@ -115,7 +124,9 @@ pub fn lift(
         // (within 60° of its own normal): at a fold, moving it away from the nearest point
         // would take it to the far side, and the move to the next lifted point through.
         let own_side = (m.kind == MoveKind::Plunge).then(|| m.cl_point - m.cc_point);
-        let Some(l) = lift_one(&near, m.cl_point, r, tol, &[], own_side, &mut stats) else {
+        let Some(l) = near.nearest_from(&m.cl_point, r, &[]).and_then(|first| {
+            lift_one(&near, m.cl_point, first, r, tol, &[], own_side, &mut stats)
+        }) else {
             continue;
         };
         lifted[i] = true;
@@ -192,20 +203,25 @@ const SEGMENT_PROBES: [f64; 3] = [0.5, 0.25, 0.75];
 struct Lifted {
     centre: Point3,
     contact: Point3,
+    /// Whether it ended within the tolerance of touching (else it is counted as residual).
+    clear: bool,
 }
 
-/// Lifts the ball centred at `c` until it is a radius from the nearest surface point (within
-/// `tol`), if it cuts in by more than `tol`; `None` if it does not.
+/// Lifts the ball centred at `c`, whose nearest surface point is `first` (distance, point),
+/// until it is a radius from the nearest surface point (within `tol`), if it cuts in by more
+/// than `tol`; `None` if it does not.
+#[allow(clippy::too_many_arguments)]
 fn lift_one(
     near: &Nearest,
     c: Point3,
+    first: (f64, Point3),
     r: f64,
     tol: f64,
     hints: &[(u32, [f64; 2])],
     own_side: Option<Vector3>,
     stats: &mut GougeStats,
 ) -> Option<Lifted> {
-    let (d, q) = near.nearest_from(&c, r, hints)?;
+    let (d, q) = first;
     let off_side = |n: Vector3| (c - q).dot(&n) < PLUNGE_LIFT_COS * d * n.norm();
     if d >= r - tol || own_side.is_some_and(off_side) {
         return None;
@@ -217,26 +233,72 @@ fn lift_one(
     stats.lifted += 1;
     let (mut c, mut nearest) = (c, (d, q));
     let mut depth = r - d;
+    // The wall the ball last touched (point, unit normal): in a spot tighter than the ball a
+    // step away from one wall takes it into the other, so the step clears both.
+    let mut last: Option<(Point3, Vector3)> = None;
+    // The depths of the last rounds, to see whether the ball gets any clearer.
+    let mut before = [f64::INFINITY; STUCK_ROUNDS];
     for round in 0..LIFT_ROUNDS {
         let (d, q) = nearest;
-        c += (c - q) / d * depth;
+        let n = (c - q) / d;
+        c += match last {
+            Some(wall) => step_clear_of_both(n, depth, wall, c, r),
+            None => n * depth,
+        };
+        last = Some((q, n));
         let Some(next) = near.nearest_from(&c, r, hints) else {
             break;
         };
         nearest = next;
+        // In a slot narrower than the ball no place clears every wall: the ball goes round
+        // them and along the slot. It stops once it has not got clearer for a few rounds.
+        let stuck = r - next.0 > STUCK_SHARE * before[0];
+        before.rotate_left(1);
+        before[STUCK_ROUNDS - 1] = depth;
         depth = r - next.0;
-        if depth <= 0.1 * tol || round + 1 == LIFT_ROUNDS {
+        if depth <= 0.1 * tol || round + 1 == LIFT_ROUNDS || stuck {
             break;
         }
     }
-    if depth > tol {
+    let clear = depth <= tol;
+    if !clear {
         stats.residual += 1;
         stats.residual_mm = stats.residual_mm.max(depth);
     }
     Some(Lifted {
         centre: c,
         contact: nearest.1,
+        clear,
     })
+}
+
+/// The step of a ball centred at `c` that takes it `depth` further along the unit normal `n`
+/// of the wall it touches, without going closer than `r` to the plane `wall` (point, unit
+/// normal) it touched before: along `n` alone where that keeps it clear of `wall`, else the
+/// shortest step that puts it `depth` further from the one and a radius from the other.
+fn step_clear_of_both(
+    n: Vector3,
+    depth: f64,
+    wall: (Point3, Vector3),
+    c: Point3,
+    r: f64,
+) -> Vector3 {
+    let plain = n * depth;
+    let (q0, n0) = wall;
+    let k = n.dot(&n0);
+    // How far inside the old wall's plane the ball is now, and would be after the plain step.
+    let e0 = r - (c - q0).dot(&n0);
+    if e0 - depth * k <= 0.0 || k.abs() > TWO_WALLS_COS {
+        return plain;
+    }
+    let det = 1.0 - k * k;
+    let both = n * ((depth - k * e0) / det) + n0 * ((e0 - k * depth) / det);
+    // Longer than the ball's diameter, the walls are no planes at that scale.
+    if both.norm() > 2.0 * r {
+        plain
+    } else {
+        both
+    }
 }
 
 /// Adds to `out`, in order from `a` to `b`, lifted cut points where the ball moving straight
@@ -256,30 +318,81 @@ fn split_segment(
         return;
     }
     let (ma, mb) = (a.0, b.0);
-    let cuts_in = SEGMENT_PROBES.iter().any(|&s| {
-        let c = ma.cl_point + (mb.cl_point - ma.cl_point) * s;
-        near.nearest_from(&c, r, hints)
-            .is_some_and(|(d, _)| d < r - tol)
-    });
-    if !cuts_in {
+    let at = |s: f64| ma.cl_point + (mb.cl_point - ma.cl_point) * s;
+    let probe = |s: f64| near.nearest_from(&at(s), r, hints);
+    // The first probe is the middle, whose nearest point the lifting starts from.
+    let middle = probe(SEGMENT_PROBES[0]);
+    let cuts_in = |x: Option<(f64, Point3)>| x.is_some_and(|(d, _)| d < r - tol);
+    if !(cuts_in(middle) || SEGMENT_PROBES[1..].iter().any(|&s| cuts_in(probe(s)))) {
         return;
     }
-    let mid = ma.cl_point + (mb.cl_point - ma.cl_point) * 0.5;
-    let (centre, contact) = match lift_one(near, mid, r, tol, hints, None, stats) {
-        Some(l) => (l.centre, l.contact),
-        None => (
-            mid,
-            near.nearest_from(&mid, r, hints)
-                .map_or(ma.cc_point, |(_, q)| q),
-        ),
-    };
+    let mid = at(SEGMENT_PROBES[0]);
+    let (centre, contact, clear) =
+        match middle.and_then(|first| lift_one(near, mid, first, r, tol, hints, None, stats)) {
+            Some(l) => (l.centre, l.contact, l.clear),
+            None => (mid, middle.map_or(ma.cc_point, |(_, q)| q), true),
+        };
     let q = [0.5 * (a.1[0] + b.1[0]), 0.5 * (a.1[1] + b.1[1])];
     let m = Move {
         cl_point: centre,
         cc_point: contact,
         ..*mb
     };
-    split_segment(near, a, (&m, q), (r, tol), hints, depth - 1, stats, out);
+    // Where the ball cannot be put clear half-way, points nearer either end would not clear
+    // the move through the middle either (the residual is reported).
+    let depth = if clear { depth - 1 } else { 0 };
+    split_segment(near, a, (&m, q), (r, tol), hints, depth, stats, out);
     out.push((m, q));
-    split_segment(near, (&m, q), b, (r, tol), hints, depth - 1, stats, out);
+    split_segment(near, (&m, q), b, (r, tol), hints, depth, stats, out);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Distance from `c` to the plane through `q` with unit normal `n`.
+    fn above(c: &Point3, (q, n): (Point3, Vector3)) -> f64 {
+        (c - q).dot(&n)
+    }
+
+    /// Between two walls (planes) whose normals are 90°, 60° and 150° apart, a ball cutting into both
+    /// is stepped onto both at once: a radius from each (closed form); where the plain step
+    /// clears the wall touched before, it is the plain step; across a slot narrower than the
+    /// ball (walls facing each other) it is the plain step, never a leap.
+    #[test]
+    fn a_ball_between_two_walls_is_stepped_onto_both() {
+        let r = 1.0;
+        let floor = (Point3::origin(), Vector3::z());
+        for deg in [90.0f64, 60.0, 150.0] {
+            let a = deg.to_radians();
+            // A wall through the origin whose normal is turned `deg` from the floor's.
+            let wall = (Point3::origin(), Vector3::new(-a.sin(), 0.0, a.cos()));
+            // The centre a radius from both (in the plane y = 0.2), pushed 0.2 mm into both.
+            let (n0, n1) = (floor.1, wall.1);
+            let k = n0.dot(&n1);
+            let x = Point3::new(0.0, 0.2, 0.0) + (n0 + n1) * (r / (1.0 + k));
+            let c = x - (n0 + n1).normalize() * 0.2;
+            let depth = r - above(&c, wall);
+            assert!(
+                depth > 0.0 && r - above(&c, floor) > 0.0,
+                "{deg}°: not inside both"
+            );
+            let step = step_clear_of_both(wall.1, depth, floor, c, r);
+            let moved = c + step;
+            for (name, plane) in [("wall", wall), ("floor", floor)] {
+                let h = above(&moved, plane);
+                assert!((h - r).abs() < 1e-12, "{deg}°: {h} mm from the {name}");
+            }
+        }
+        // The floor already clear after the plain step: the plain step.
+        let wall = (Point3::origin(), Vector3::new(-1.0, 0.0, 0.0));
+        let c = Point3::new(-0.5, 0.0, 1.5);
+        let step = step_clear_of_both(wall.1, 0.5, floor, c, r);
+        assert_eq!(step, wall.1 * 0.5);
+        // Walls 1.6 mm apart facing each other: no place a radius from both.
+        let roof = (Point3::new(0.0, 0.0, 1.6), -Vector3::z());
+        let c = Point3::new(0.0, 0.0, 0.7);
+        let step = step_clear_of_both(roof.1, r - above(&c, roof), floor, c, r);
+        assert_eq!(step, roof.1 * (r - above(&c, roof)));
+    }
 }

@@ -24,13 +24,63 @@ pub(super) struct Nearest<'a> {
     surface: &'a Surface,
     boxes: Vec<Aabb>,
     starts: Vec<Vec<(f64, f64, Point3)>>,
-    /// The faces whose box meets each cell of a uniform grid (cells of `cell` mm).
-    cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
-    cell: f64,
+    /// The faces' boxes in a hierarchy: `nodes[0]` is the root.
+    nodes: Vec<Node>,
+    /// Faces in the order the leaves list them.
+    order: Vec<u32>,
 }
 
-/// Most grid cells one face's box may be listed in; larger boxes make the cells coarser.
-const CELLS_PER_FACE: f64 = 64.0;
+/// Faces per leaf of the hierarchy.
+const LEAF_FACES: usize = 4;
+
+/// A node of the hierarchy: its box, and either two children or a range of faces.
+struct Node {
+    bounds: Aabb,
+    /// The first child (the second follows it) when `count` is 0, else the first of
+    /// `count` faces in `order`.
+    first: u32,
+    count: u32,
+}
+
+impl Node {
+    /// A node with nothing in it (and a placeholder while building).
+    const EMPTY: Node = Node {
+        bounds: Aabb {
+            min: [f64::INFINITY; 3],
+            max: [f64::NEG_INFINITY; 3],
+        },
+        first: 0,
+        count: 0,
+    };
+}
+
+/// An entry of the nearest-first search: a node or a face, by the distance to its box.
+#[derive(PartialEq)]
+struct Queued {
+    bound: f64,
+    face: bool,
+    index: u32,
+}
+
+impl Eq for Queued {}
+
+impl Ord for Queued {
+    /// Reversed, so that the standard (max-)heap pops the nearest box first; ties by faces
+    /// before nodes and by index.
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        other
+            .bound
+            .total_cmp(&self.bound)
+            .then(self.face.cmp(&other.face))
+            .then(other.index.cmp(&self.index))
+    }
+}
+
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
 
 impl<'a> Nearest<'a> {
     pub(super) fn new(surface: &'a Surface) -> Self {
@@ -61,60 +111,52 @@ impl<'a> Nearest<'a> {
             boxes.push(b);
             starts.push(s);
         }
-        // Cells about the size of a face's box, coarser if some boxes would span too many.
-        let sizes: Vec<f64> = boxes
-            .iter()
-            .map(|b| (0..3).map(|k| b.max[k] - b.min[k]).fold(0.0, f64::max))
-            .collect();
-        let mean = sizes.iter().sum::<f64>() / sizes.len().max(1) as f64;
-        let largest = sizes.iter().fold(0.0f64, |a, &b| a.max(b));
-        let cell = mean
-            .max(largest / CELLS_PER_FACE.cbrt())
-            .max(f64::MIN_POSITIVE);
-        let mut cells: std::collections::HashMap<[i64; 3], Vec<u32>> = Default::default();
-        for (f, b) in boxes.iter().enumerate() {
-            let (lo, hi) = (cell_of(&b.min, cell), cell_of(&b.max, cell));
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        cells.entry([x, y, z]).or_default().push(f as u32);
-                    }
-                }
-            }
+        let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+        let mut nodes = vec![Node::EMPTY];
+        if !boxes.is_empty() {
+            build(&boxes, &mut order, 0, 0, &mut nodes);
         }
         Nearest {
             surface,
             boxes,
             starts,
-            cells,
-            cell,
+            nodes,
+            order,
         }
     }
 
     /// Faces whose box comes within `reach` of `c`, in order.
     pub(super) fn faces_near(&self, c: &Point3, reach: f64) -> Vec<u32> {
-        let lo = cell_of(&[c.x - reach, c.y - reach, c.z - reach], self.cell);
-        let hi = cell_of(&[c.x + reach, c.y + reach, c.z + reach], self.cell);
-        let mut faces: Vec<u32> = Vec::new();
-        for x in lo[0]..=hi[0] {
-            for y in lo[1]..=hi[1] {
-                for z in lo[2]..=hi[2] {
-                    if let Some(fs) = self.cells.get(&[x, y, z]) {
-                        faces.extend_from_slice(fs);
-                    }
+        self.faces_within(c, reach)
+            .into_iter()
+            .map(|(_, f)| f)
+            .collect()
+    }
+
+    /// Faces whose box comes within `reach` of `c`, each with the distance from `c` to its
+    /// box (mm; a bound below the distance to any point of the face), in face order.
+    fn faces_within(&self, c: &Point3, reach: f64) -> Vec<(f64, u32)> {
+        let mut out = Vec::new();
+        let mut stack = vec![0u32];
+        while let Some(k) = stack.pop() {
+            let node = &self.nodes[k as usize];
+            if box_distance(&node.bounds, c) > reach {
+                continue;
+            }
+            if node.count == 0 {
+                stack.extend([node.first, node.first + 1]);
+                continue;
+            }
+            let at = node.first as usize..(node.first + node.count) as usize;
+            for &f in &self.order[at] {
+                let d = box_distance(&self.boxes[f as usize], c);
+                if d <= reach {
+                    out.push((d, f));
                 }
             }
         }
-        faces.sort_unstable();
-        faces.dedup();
-        faces.retain(|&f| {
-            let b = &self.boxes[f as usize];
-            let out = (0..3)
-                .map(|k| (b.min[k] - c[k]).max(c[k] - b.max[k]).max(0.0))
-                .fold(0.0f64, |a, x| a.hypot(x));
-            out <= reach
-        });
-        faces
+        out.sort_unstable_by_key(|e| e.1);
+        out
     }
 
     /// The start sample of face `f` nearest `c`: its parameters.
@@ -130,14 +172,74 @@ impl<'a> Nearest<'a> {
     }
 
     /// Nearest point to `c` on faces whose box comes within `reach` of it, and its distance.
+    #[cfg(test)]
     pub(super) fn nearest(&self, c: &Point3, reach: f64) -> Option<(f64, Point3)> {
-        let mut best: Option<(f64, Point3)> = None;
-        for f in self.faces_near(c, reach) {
-            let f = f as usize;
+        self.nearest_from(c, reach, &[])
+    }
+
+    /// As [`Nearest::nearest`], also searching from `hints` (face, parameters in its unit
+    /// square): the samples nearest `c` may lie in another valley of the distance than the
+    /// nearest point (a face folded or creased inside).
+    ///
+    /// The faces are searched nearest box first, and a face whose box lies farther than the
+    /// nearest point found so far is not searched: no point of it can be nearer. The answer
+    /// is the one a search of every face in order would give: the least distance, on a tie
+    /// the first face (and start) in face order, then the hints in order.
+    pub(super) fn nearest_from(
+        &self,
+        c: &Point3,
+        reach: f64,
+        hints: &[(u32, [f64; 2])],
+    ) -> Option<(f64, Point3)> {
+        // The best so far: distance, point, and its place in the order of a full search.
+        type Best = Option<(f64, Point3, (u32, usize))>;
+        let offer = |best: &mut Best, d: f64, p: Point3, key: (u32, usize)| match *best {
+            Some((bd, _, bk)) if bd < d || (bd == d && bk <= key) => {}
+            _ => *best = Some((d, p, key)),
+        };
+        let mut best: Best = None;
+        // Boxes nearest first: nodes open into their children, faces are searched.
+        let mut queue = std::collections::BinaryHeap::new();
+        if let Some(root) = self.nodes.first() {
+            queue.push(Queued {
+                bound: box_distance(&root.bounds, c),
+                face: false,
+                index: 0,
+            });
+        }
+        while let Some(Queued { bound, face, index }) = queue.pop() {
+            if bound > reach || best.is_some_and(|b| bound > b.0) {
+                break;
+            }
+            if !face {
+                let node = &self.nodes[index as usize];
+                let (kids, faces) = if node.count == 0 {
+                    (node.first..node.first + 2, &[][..])
+                } else {
+                    let at = node.first as usize..(node.first + node.count) as usize;
+                    (0..0, &self.order[at])
+                };
+                for k in kids {
+                    queue.push(Queued {
+                        bound: box_distance(&self.nodes[k as usize].bounds, c),
+                        face: false,
+                        index: k,
+                    });
+                }
+                for &f in faces {
+                    queue.push(Queued {
+                        bound: box_distance(&self.boxes[f as usize], c),
+                        face: true,
+                        index: f,
+                    });
+                }
+                continue;
+            }
+            let fi = index as usize;
             // Newton from the nearest few samples: on a tightly folded face the nearest
             // sample may lie on the wrong side of the fold.
             let mut starts = [(f64::INFINITY, 0.0, 0.0); NEAREST_STARTS];
-            for &(u, v, p) in &self.starts[f] {
+            for &(u, v, p) in &self.starts[fi] {
                 let d = (p - c).norm_squared();
                 // Kept in order, nearest first (ties: the earlier sample).
                 if d < starts[NEAREST_STARTS - 1].0 {
@@ -146,37 +248,23 @@ impl<'a> Nearest<'a> {
                     starts[at] = (d, u, v);
                 }
             }
-            for &(d, u, v) in &starts {
+            for (k, &(d, u, v)) in starts.iter().enumerate() {
                 if !d.is_finite() {
                     break;
                 }
-                let (d, p) = self.descend(f, c, u, v);
-                match best {
-                    Some((bd, _)) if bd <= d => {}
-                    _ => best = Some((d, p)),
-                }
+                let (d, p) = self.descend(fi, c, u, v);
+                offer(&mut best, d, p, (index, k));
             }
         }
-        best
-    }
-
-    /// As [`Nearest::nearest`], also searching from `hints` (face, parameters in its unit
-    /// square): the samples nearest `c` may lie in another valley of the distance than the
-    /// nearest point (a face folded or creased inside).
-    pub(super) fn nearest_from(
-        &self,
-        c: &Point3,
-        reach: f64,
-        hints: &[(u32, [f64; 2])],
-    ) -> Option<(f64, Point3)> {
-        let mut best = self.nearest(c, reach);
-        for &(f, [u, v]) in hints {
+        // The hints come after every face; one whose box lies beyond the best cannot win.
+        for (k, &(f, [u, v])) in hints.iter().enumerate() {
+            if best.is_some_and(|b| box_distance(&self.boxes[f as usize], c) > b.0) {
+                continue;
+            }
             let (d, p) = self.descend(f as usize, c, u, v);
-            if best.is_none_or(|(bd, _)| d < bd) {
-                best = Some((d, p));
-            }
+            offer(&mut best, d, p, (u32::MAX, k));
         }
-        best
+        best.map(|(d, p, _)| (d, p))
     }
 
     /// Local nearest point to `c` on face `f` from `(u, v)`: Newton steps on the squared
@@ -287,7 +375,137 @@ pub(super) struct Foot {
     pub uv: [f64; 2],
 }
 
-/// The grid cell holding `p` for cells of `cell` mm.
-fn cell_of(p: &[f64; 3], cell: f64) -> [i64; 3] {
-    p.map(|x| (x / cell).floor() as i64)
+/// Distance from `c` to the box `b` (mm; zero inside it).
+fn box_distance(b: &Aabb, c: &Point3) -> f64 {
+    (0..3)
+        .map(|k| (b.min[k] - c[k]).max(c[k] - b.max[k]).max(0.0))
+        .fold(0.0f64, |a, x| a.hypot(x))
+}
+
+/// Fills `nodes[slot]` with the hierarchy's node over `order` (faces with boxes `boxes`,
+/// reordered in place; the first at index `offset` of the whole order) and appends its
+/// descendants, splitting at the median of the boxes' middles along their widest spread.
+fn build(boxes: &[Aabb], order: &mut [u32], offset: usize, slot: usize, nodes: &mut Vec<Node>) {
+    let mut bounds = Aabb::empty();
+    let mut middles = Aabb::empty();
+    for &f in order.iter() {
+        let b = &boxes[f as usize];
+        bounds.grow(&Point3::from(b.min));
+        bounds.grow(&Point3::from(b.max));
+        middles.grow(&Point3::from(middle(b)));
+    }
+    if order.len() <= LEAF_FACES {
+        nodes[slot] = Node {
+            bounds,
+            first: offset as u32,
+            count: order.len() as u32,
+        };
+        return;
+    }
+    let spread = middles.size();
+    let axis = (0..3).fold(0, |a, k| if spread[k] > spread[a] { k } else { a });
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&a, &b| {
+        let (ma, mb) = (middle(&boxes[a as usize]), middle(&boxes[b as usize]));
+        ma[axis].total_cmp(&mb[axis]).then(a.cmp(&b))
+    });
+    // The two children side by side, each subtree after them.
+    let first = nodes.len();
+    nodes.extend([Node::EMPTY, Node::EMPTY]);
+    nodes[slot] = Node {
+        bounds,
+        first: first as u32,
+        count: 0,
+    };
+    let (lo, hi) = order.split_at_mut(mid);
+    build(boxes, lo, offset, first, nodes);
+    build(boxes, hi, offset + mid, first + 1, nodes);
+}
+
+/// The middle of box `b`.
+fn middle(b: &Aabb) -> [f64; 3] {
+    [0, 1, 2].map(|k| 0.5 * (b.min[k] + b.max[k]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Vector3;
+
+    /// Every face searched from its nearest starts, in face order (the search before the
+    /// hierarchy and the pruning): the least distance, the first on a tie.
+    fn every_face(near: &Nearest, c: &Point3, reach: f64) -> Option<(f64, Point3)> {
+        let mut best: Option<(f64, Point3)> = None;
+        for f in 0..near.boxes.len() {
+            if box_distance(&near.boxes[f], c) > reach {
+                continue;
+            }
+            let mut starts: Vec<(f64, usize)> = near.starts[f]
+                .iter()
+                .enumerate()
+                .map(|(k, s)| ((s.2 - c).norm_squared(), k))
+                .collect();
+            starts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for &(_, k) in starts.iter().take(NEAREST_STARTS) {
+                let (u, v, _) = near.starts[f][k];
+                let (d, p) = near.descend(f, c, u, v);
+                if best.is_none_or(|(bd, _)| d < bd) {
+                    best = Some((d, p));
+                }
+            }
+        }
+        best
+    }
+
+    /// The hierarchy searched nearest box first, and faces beyond the best found left out,
+    /// give what searching every face gives, to the bit: on a subdivision cage of 1 575
+    /// faces (OpenSubdiv's car, the ball as large as a wheel) and on a T-spline with
+    /// creases, from points near and far from the surface.
+    #[test]
+    fn the_pruned_search_finds_what_every_face_finds() {
+        let root = env!("CARGO_MANIFEST_DIR");
+        let load = |path: &str| {
+            let bytes = std::fs::read(format!("{root}/{path}")).unwrap();
+            crate::io::load(&bytes, path).unwrap()
+        };
+        let cases = [
+            (load("tests/fixtures/opensubdiv/catmark_car.obj"), 0.5),
+            (load("www/models/grapetec/face.tsm"), 0.5),
+        ];
+        let mut next = crate::testing::uniform(0x9e37_79b9_7f4a_7c15);
+        for (model, r) in cases {
+            let near = Nearest::new(&model.surface);
+            let faces = model.surface.faces().len();
+            let (mut found, mut pruned_to) = (0, 0);
+            for _ in 0..300 {
+                let f = ((next() * faces as f64) as usize).min(faces - 1);
+                let p = model.surface.subs(f, next(), next());
+                let off = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5) * (3.0 * r);
+                let c = p + off;
+                let want = every_face(&near, &c, r);
+                let got = near.nearest(&c, r);
+                assert_eq!(
+                    got.map(|(d, p)| (d.to_bits(), p.coords.map(f64::to_bits))),
+                    want.map(|(d, p)| (d.to_bits(), p.coords.map(f64::to_bits))),
+                    "{}: nearest to ({:.4}, {:.4}, {:.4}) mm",
+                    model.name,
+                    c.x,
+                    c.y,
+                    c.z
+                );
+                found += usize::from(got.is_some());
+                pruned_to += near.faces_near(&c, r).len();
+            }
+            println!(
+                "{}: {found} of 300 points within {r} mm of the surface; {:.1} faces within reach on average",
+                model.name,
+                pruned_to as f64 / 300.0
+            );
+            assert!(
+                found > 100,
+                "{}: too few points near the surface",
+                model.name
+            );
+        }
+    }
 }
