@@ -291,6 +291,9 @@ const COARSE_WORK_PER_MOVE: usize = 64;
 /// The finer grid's cells: twice the median footprint reach of the lifted points, and no
 /// fewer than 1/this of the reach (so one footprint spans a bounded number of cells).
 const FINE_CELLS_PER_REACH: f64 = 32.0;
+/// Relative widening of a footprint sphere's box in the finer grid, so that rounding cannot
+/// keep two spheres that meet out of a shared cell (dimensionless).
+const ROUNDING_WIDENING: f64 = 1e-9;
 
 /// The cut points whose footprints may touch a lifted point's, each with its footprint's
 /// `extent` (mm): contacts within `reach` of a lifted point's contact whose footprints'
@@ -367,7 +370,7 @@ fn touching_lifted(
     drop(grid);
     // The finer grid: each lifted footprint's sphere in the cells its box meets (widened by
     // a little for rounding).
-    let radius = |e: f64| e * (1.0 + TOUCH_SLACK) * (1.0 + 1e-9);
+    let radius = |e: f64| e * (1.0 + TOUCH_SLACK) * (1.0 + ROUNDING_WIDENING);
     let mut spheres: Vec<f64> = lifted_extent.iter().map(|&e| radius(e)).collect();
     let mid = spheres.len() / 2;
     let median = *spheres.select_nth_unstable_by(mid, f64::total_cmp).1;

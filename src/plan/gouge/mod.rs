@@ -44,9 +44,9 @@ pub struct GougeStats {
 const PLUNGE_LIFT_COS: f64 = 0.5;
 /// Lifting rounds per CL point (each moves it away from the then nearest point).
 const LIFT_ROUNDS: usize = 8;
-/// A lift stops when its depth is more than this share of the depth this many rounds
-/// before (it is not getting clearer: the ball is in a slot narrower than it, between three
-/// or more walls).
+/// A lift stops when its depth is more than this share of its depth `STUCK_ROUNDS + 1`
+/// measurements earlier (it is not getting clearer: the ball is in a slot narrower than it,
+/// between three or more walls).
 const STUCK_SHARE: f64 = 0.5;
 const STUCK_ROUNDS: usize = 2;
 /// Least angle between two walls a lifted ball touches, or between one and the other's
