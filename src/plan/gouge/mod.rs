@@ -53,6 +53,9 @@ const STUCK_ROUNDS: usize = 2;
 /// opposite, for a step to clear both at once (as the cosine between their normals; 2.6°):
 /// nearer parallel, one wall's step serves.
 const TWO_WALLS_COS: f64 = 0.999;
+/// A ball centre nearer the surface than this share of the radius counts as on it: the way
+/// from the nearest point to it gives no direction to lift along (dimensionless).
+const ON_SURFACE_SHARE: f64 = 1e-9;
 /// Moves between two checks for cancellation.
 const CANCEL_EVERY: usize = 256;
 
@@ -125,7 +128,18 @@ pub fn lift(
         // would take it to the far side, and the move to the next lifted point through.
         let own_side = (m.kind == MoveKind::Plunge).then(|| m.cl_point - m.cc_point);
         let Some(l) = near.nearest_from(&m.cl_point, r, &[]).and_then(|first| {
-            lift_one(&near, m.cl_point, first, r, tol, &[], own_side, &mut stats)
+            let away = m.cl_point - m.cc_point;
+            lift_one(
+                &near,
+                m.cl_point,
+                first,
+                r,
+                tol,
+                &[],
+                own_side,
+                away,
+                &mut stats,
+            )
         }) else {
             continue;
         };
@@ -209,7 +223,9 @@ struct Lifted {
 
 /// Lifts the ball centred at `c`, whose nearest surface point is `first` (distance, point),
 /// until it is a radius from the nearest surface point (within `tol`), if it cuts in by more
-/// than `tol`; `None` if it does not.
+/// than `tol`; `None` if it does not. Where its centre lies on the surface (no way away from
+/// the nearest point), it is lifted along `away`, its own tool side (from its contact
+/// point to its centre), or left where it is (residual) if that has no direction either.
 #[allow(clippy::too_many_arguments)]
 fn lift_one(
     near: &Nearest,
@@ -219,6 +235,7 @@ fn lift_one(
     tol: f64,
     hints: &[(u32, [f64; 2])],
     own_side: Option<Vector3>,
+    away: Vector3,
     stats: &mut GougeStats,
 ) -> Option<Lifted> {
     let (d, q) = first;
@@ -240,7 +257,15 @@ fn lift_one(
     let mut before = [f64::INFINITY; STUCK_ROUNDS];
     for round in 0..LIFT_ROUNDS {
         let (d, q) = nearest;
-        let n = (c - q) / d;
+        let least = ON_SURFACE_SHARE * r;
+        let n = if d > least {
+            (c - q) / d
+        } else {
+            match away.try_normalize(least) {
+                Some(n) => n,
+                None => break,
+            }
+        };
         c += match last {
             Some(wall) => step_clear_of_both(n, depth, wall, c, r),
             None => n * depth,
@@ -327,11 +352,13 @@ fn split_segment(
         return;
     }
     let mid = at(SEGMENT_PROBES[0]);
-    let (centre, contact, clear) =
-        match middle.and_then(|first| lift_one(near, mid, first, r, tol, hints, None, stats)) {
-            Some(l) => (l.centre, l.contact, l.clear),
-            None => (mid, middle.map_or(ma.cc_point, |(_, q)| q), true),
-        };
+    let away = (ma.cl_point - ma.cc_point) + (mb.cl_point - mb.cc_point);
+    let (centre, contact, clear) = match middle
+        .and_then(|first| lift_one(near, mid, first, r, tol, hints, None, away, stats))
+    {
+        Some(l) => (l.centre, l.contact, l.clear),
+        None => (mid, middle.map_or(ma.cc_point, |(_, q)| q), true),
+    };
     let q = [0.5 * (a.1[0] + b.1[0]), 0.5 * (a.1[1] + b.1[1])];
     let m = Move {
         cl_point: centre,
@@ -353,6 +380,40 @@ mod tests {
     /// Distance from `c` to the plane through `q` with unit normal `n`.
     fn above(c: &Point3, (q, n): (Point3, Vector3)) -> f64 {
         (c - q).dot(&n)
+    }
+
+    /// A ball centred on the surface itself (catmark_rook.obj read in centimetres, r 0.5
+    /// mm: a centre landed exactly on a wall across a slot, and the lift's direction, from
+    /// the nearest point to the centre, was 0 / 0) is lifted along its own tool side to a
+    /// radius from the surface, not to NaN.
+    #[test]
+    fn a_ball_centred_on_the_surface_is_lifted_along_its_own_side() {
+        let model = crate::model::samples::load_sample("dome").unwrap();
+        let near = Nearest::new(&model.surface);
+        let (r, tol) = (0.5, 1e-4);
+        let patch = &model.layout.patches[0];
+        let q = patch.subs(&model.surface, 0.4, 0.6);
+        let n = patch.normal(&model.surface, 0.4, 0.6).unwrap() * model.tool_side();
+        let mut stats = GougeStats::default();
+        let l = lift_one(&near, q, (0.0, q), r, tol, &[], None, n * r, &mut stats).unwrap();
+        let (d, _) = near.nearest_from(&l.centre, r, &[]).unwrap();
+        assert!(l.clear && (d - r).abs() <= tol, "{:?} at {d} mm", l.centre);
+        assert!((l.centre - q).dot(&n) > r - tol, "{:?}", l.centre);
+        // With no side of its own either, it stays where it is, counted as residual.
+        let mut stats = GougeStats::default();
+        let l = lift_one(
+            &near,
+            q,
+            (0.0, q),
+            r,
+            tol,
+            &[],
+            None,
+            Vector3::zeros(),
+            &mut stats,
+        );
+        assert_eq!(l.map(|l| (l.centre, l.clear)), Some((q, false)));
+        assert_eq!(stats.residual, 1);
     }
 
     /// Between two walls (planes) whose normals are 90°, 60° and 150° apart, a ball cutting into both
