@@ -13,12 +13,12 @@
 use super::draft::{Draft, Footprint};
 use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
 use crate::error::Result;
-use crate::geom::Point3;
+use crate::geom::{Point3, Vector3};
 use crate::model::Model;
 use crate::surface::diffgeom::unit_normal;
 use crate::verify::capsule::Capsule;
 use crate::verify::index::CapsuleIndex;
-use crate::verify::probe::{Material, Probe};
+use crate::verify::probe::{Material, Probe, Reading};
 use crate::verify::CutterPath;
 use serde::{Deserialize, Serialize};
 
@@ -250,6 +250,12 @@ const LEFT_OUT_GRID: ShareGrid = ShareGrid {
     samples: 3,
     halvings: 2,
 };
+/// What a swept point reads in the grid and pattern search for the highest material left
+/// in a footprint (mm): its measured value would be the cut's depth below the surface, at
+/// most 0, and those searches compare a point's value only with values above
+/// [`TIGHT_SEARCH_FROM`] times the scallop and with the scallop, so any value not above 0
+/// decides the same.
+const SWEPT_OVER: f64 = 0.0;
 /// Halvings of the pattern search for the highest material left in a footprint: it starts
 /// at half the grid step and ends at 1/1024 of the footprint.
 const TIGHT_SEARCH_HALVINGS: usize = 9;
@@ -492,7 +498,7 @@ pub fn tight_near_lifts(
     };
     let near_mm = probe.probe.near_mm();
     let share = 1.0 / candidates.len().max(1) as f64;
-    for (k, (i, own)) in candidates.into_iter().enumerate() {
+    'footprints: for (k, (i, own)) in candidates.into_iter().enumerate() {
         if k % PROGRESS_EVERY == 0 && !progress(share * k as f64) {
             return None;
         }
@@ -505,11 +511,16 @@ pub fn tight_near_lifts(
         // A grid, then a pattern search from its highest sample: where a crease meets the
         // cusp between two passes the material left peaks sharply.
         let (du, dv) = grid_step(&f, TIGHT_SAMPLES);
-        let grid: Vec<(f64, f64, f64)> = probe
-            .grid(&f, TIGHT_SAMPLES)
-            .into_iter()
-            .map(|(c, u, v)| (c.over, u, v))
-            .collect();
+        // Any sample with more than the scallop left decides.
+        let mut grid = Vec::with_capacity(TIGHT_SAMPLES * TIGHT_SAMPLES);
+        for (u, v) in grid_points(&f, TIGHT_SAMPLES) {
+            let over = probe.over_read(&f, u, v, scallop_mm);
+            if over > scallop_mm {
+                tight[i] = true;
+                continue 'footprints;
+            }
+            grid.push((over, u, v));
+        }
         // The search starts from the grid's local maxima high enough to matter, highest first.
         let at_grid = |a: usize, b: usize| grid[a * TIGHT_SAMPLES + b].0;
         let mut starts: Vec<(f64, f64, f64)> = Vec::new();
@@ -549,7 +560,7 @@ pub fn tight_near_lifts(
                 let (_, u, v) = best;
                 for (a, b) in PATTERN {
                     let (x, y) = ((u + a * su).clamp(u0, u1), (v + b * sv).clamp(v0, v1));
-                    let l = probe.sample(&f, x, y).over;
+                    let l = probe.over_read(&f, x, y, scallop_mm);
                     if l > best.0 {
                         best = (l, x, y);
                     }
@@ -586,6 +597,10 @@ pub fn tight_near_lifts(
                 for k in 0..=n {
                     let (u, v) = at_x(k as f64 / n as f64);
                     let l = left_at(u, v);
+                    if l > scallop_mm {
+                        tight[i] = true;
+                        continue 'footprints;
+                    }
                     if l > best.0 {
                         best = (l, k);
                     }
@@ -614,6 +629,10 @@ pub fn tight_near_lifts(
                         x1 = hi - phi * (hi - lo);
                         f1 = f(x1, &mut left_at);
                     }
+                    if f1.max(f2) > scallop_mm {
+                        tight[i] = true;
+                        continue 'footprints;
+                    }
                 }
                 top = top.max(best.0).max(f1).max(f2);
             }
@@ -634,17 +653,24 @@ struct FootprintProbe<'a> {
 }
 
 impl FootprintProbe<'_> {
-    /// The material left at `(u, v)` (clamped into footprint `f`) above the surface, and
-    /// the area element there (mm² per unit of u and v); −∞ left where the surface has no
-    /// normal.
-    fn sample(&mut self, f: &Footprint, u: f64, v: f64) -> Corner {
+    /// The surface point at `(u, v)` (clamped into footprint `f`), the area element there
+    /// (mm² per unit of u and v) and the tool-side unit normal, if the surface has one.
+    fn surface_at(&self, f: &Footprint, u: f64, v: f64) -> (Point3, f64, Option<Vector3>) {
         let [u0, u1, v0, v1] = f.rect;
         let (u, v) = (u.clamp(u0, u1), v.clamp(v0, v1));
         let (model, p) = (self.model, &self.model.layout.patches[f.patch as usize]);
         let (point, su, sv) = p.first_derivs(&model.surface, u, v);
         let area = su.cross(&sv).norm();
         let nrm = unit_normal(&su, &sv).or_else(|| p.normal(&model.surface, u, v));
-        let over = match nrm.map(|n| self.probe.measure(&point, &(n * self.side))) {
+        (point, area, nrm.map(|n| n * self.side))
+    }
+
+    /// The material left at `(u, v)` (clamped into footprint `f`) above the surface, and
+    /// the area element there (mm² per unit of u and v); −∞ left where the surface has no
+    /// normal.
+    fn sample(&mut self, f: &Footprint, u: f64, v: f64) -> Corner {
+        let (point, area, nrm) = self.surface_at(f, u, v);
+        let over = match nrm.map(|n| self.probe.measure(&point, &n)) {
             None => f64::NEG_INFINITY,
             Some(Material::Left { left_mm, .. }) => left_mm,
             Some(Material::Unreached) => self.unreached_mm,
@@ -652,19 +678,36 @@ impl FootprintProbe<'_> {
         Corner { over, area }
     }
 
+    /// As [`FootprintProbe::sample`]'s `over`, read against `scallop_mm`
+    /// ([`Probe::read_against`]): a swept point reads [`SWEPT_OVER`] instead of how deep,
+    /// and a point with more than the scallop left may read +∞ instead of how much.
+    fn over_read(&mut self, f: &Footprint, u: f64, v: f64, scallop_mm: f64) -> f64 {
+        let (point, _, nrm) = self.surface_at(f, u, v);
+        let Some(n) = nrm else {
+            return f64::NEG_INFINITY;
+        };
+        match self.probe.read_against(&point, &n, scallop_mm) {
+            Reading::Swept => SWEPT_OVER,
+            Reading::Left(left_mm) => left_mm,
+            Reading::Over => f64::INFINITY,
+            Reading::Unreached => self.unreached_mm,
+        }
+    }
+
     /// A grid of `n`² samples of `f` (corners included, row by row in u): the material left
     /// as `over` (mm), and where.
     fn grid(&mut self, f: &Footprint, n: usize) -> Vec<(Corner, f64, f64)> {
-        let (du, dv) = grid_step(f, n);
-        let mut out = Vec::with_capacity(n * n);
-        for a in 0..n {
-            for b in 0..n {
-                let (u, v) = (f.rect[0] + du * a as f64, f.rect[2] + dv * b as f64);
-                out.push((self.sample(f, u, v), u, v));
-            }
-        }
-        out
+        grid_points(f, n)
+            .map(|(u, v)| (self.sample(f, u, v), u, v))
+            .collect()
     }
+}
+
+/// The `n`² points of a grid over footprint `f` (corners included, row by row in u).
+fn grid_points(f: &Footprint, n: usize) -> impl Iterator<Item = (f64, f64)> {
+    let (du, dv) = grid_step(f, n);
+    let (u0, v0) = (f.rect[0], f.rect[2]);
+    (0..n).flat_map(move |a| (0..n).map(move |b| (u0 + du * a as f64, v0 + dv * b as f64)))
 }
 
 /// The share of each footprint's area that `path` (the final tool path, air moves

@@ -30,6 +30,19 @@ pub enum Material {
     Unreached,
 }
 
+/// What [`Probe::read_against`] found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reading {
+    /// The point was swept (a cut reaches it or goes below it; how deep is not measured).
+    Swept,
+    /// This much material is left above the point (mm), as [`Probe::measure`] finds it.
+    Left(f64),
+    /// More material than the level read against is left (how much is not measured).
+    Over,
+    /// No swept ball comes within the reach along the normal.
+    Unreached,
+}
+
 /// A reusable query context (one per thread): the index, the capsules and scratch space.
 pub struct Probe<'a> {
     capsules: &'a [Capsule],
@@ -155,6 +168,112 @@ impl<'a> Probe<'a> {
                     hits.push((i, h));
                 }
             });
+    }
+
+    /// Gathers the hits of the first look of [`Probe::measure`] (over `[−near, near]`),
+    /// stopping at the first capsule containing `p`: returns whether there is one (then
+    /// the hits are incomplete) or, if not, leaves every hit of that look gathered.
+    fn gather_unless_swept(&mut self, p: &Point3, n: &Vector3) -> bool {
+        let near = self.near_mm();
+        self.hits.clear();
+        let (a, b) = (p - n * near, p + n * near);
+        let focused = self.focused(&a, &b);
+        if !focused {
+            self.next_stamp();
+        }
+        let (caps, r) = (self.capsules, self.radius);
+        let hits = &mut self.hits;
+        let mut found = false;
+        // Tests capsule `i` unless one containing `p` was found; says whether one was.
+        let mut test = |i: u32| {
+            if !found {
+                if let Some(h) = caps[i as usize].interval(r, p, n, -near, near) {
+                    found = h.t_in <= 0.0 && h.t_out >= 0.0;
+                    hits.push((i, h));
+                }
+            }
+            found
+        };
+        match (&self.focus, focused) {
+            (Some(f), true) => {
+                for &i in &f.capsules {
+                    if test(i) {
+                        return true;
+                    }
+                }
+                false
+            }
+            _ => {
+                let mut swept = false;
+                self.index
+                    .visit(caps, &a, &b, &mut self.seen, self.stamp, |i| {
+                        swept = test(i);
+                    });
+                swept
+            }
+        }
+    }
+
+    /// Whether the focus holds every capsule meeting the segment from `a` to `b`.
+    fn focused(&self, a: &Point3, b: &Point3) -> bool {
+        self.focus
+            .as_ref()
+            .is_some_and(|f| (a - f.centre).norm() <= f.radius && (b - f.centre).norm() <= f.radius)
+    }
+
+    /// What [`Probe::measure`] finds at `p` along the unit tool-side normal `n`, read
+    /// against `level` (mm): how deep a swept point was cut and how much more than `level`
+    /// is left are not measured, where finding them would cost more than the rest (many
+    /// overlapping balls; a long look along the normal). Material left up to `level` is
+    /// measured as [`Probe::measure`] does.
+    pub fn read_against(&mut self, p: &Point3, n: &Vector3, level: f64) -> Reading {
+        if self.gather_unless_swept(p, n) {
+            return Reading::Swept;
+        }
+        self.depth = None;
+        let near = self.near_mm();
+        // As `measure`: nothing contains `p`, so the first capsule entered decides.
+        if let Some(t) = self
+            .hits
+            .iter()
+            .filter(|(_, h)| h.t_in > 0.0 && h.t_in <= near)
+            .map(|(_, h)| h.t_in)
+            .min_by(f64::total_cmp)
+        {
+            return Reading::Left(t);
+        }
+        if level > near {
+            return match self.measure(p, n) {
+                Material::Left { left_mm, .. } => Reading::Left(left_mm),
+                Material::Unreached => Reading::Unreached,
+            };
+        }
+        // More than `near` is left if any ball comes within the reach: look up to it, and
+        // stop at the first.
+        let (a, b) = (p + n * near, p + n * self.reach);
+        let focused = self.focused(&a, &b);
+        if !focused {
+            self.next_stamp();
+        }
+        let (caps, r, reach) = (self.capsules, self.radius, self.reach);
+        let mut found = false;
+        let mut test = |i: u32| {
+            found = found
+                || caps[i as usize]
+                    .interval(r, p, n, near, reach)
+                    .is_some_and(|h| h.t_in > 0.0);
+        };
+        match (&self.focus, focused) {
+            (Some(f), true) => f.capsules.iter().for_each(|&i| test(i)),
+            _ => self
+                .index
+                .visit(caps, &a, &b, &mut self.seen, self.stamp, test),
+        }
+        if found {
+            Reading::Over
+        } else {
+            Reading::Unreached
+        }
     }
 
     /// The capsule nearest to `p` (distance from its segment) within `within` mm, and the
@@ -369,5 +488,54 @@ mod tests {
             gouges > 100 && left > 100 && unreached > 10,
             "{gouges} {left} {unreached}"
         );
+    }
+
+    /// A reading against a level says what the full measurement says: swept where it
+    /// finds the point cut (left ≤ 0), the same material left up to the level, more than the
+    /// level where it reads `Over`, unreached alike; through the index and through a focus,
+    /// with the level below and above the first look's length.
+    #[test]
+    fn reading_against_a_level_agrees_with_the_measurement() {
+        let mut rnd = crate::testing::uniform(4711u64);
+        let r = 0.5;
+        let mut capsules = Vec::new();
+        for _ in 0..400 {
+            let a = Point3::new(6.0 * rnd(), 6.0 * rnd(), r - 0.3 + 1.2 * rnd());
+            let d = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 * (rnd() - 0.5)) * 2.0;
+            capsules.push(Capsule::new(a, a + d));
+        }
+        let region = Aabb {
+            min: [-2.0, -2.0, -3.0],
+            max: [8.0, 8.0, 3.0],
+        };
+        let index = CapsuleIndex::build(&capsules, r, &region, 0.5 * r);
+        let mut probe = Probe::new(&capsules, &index, r, r, 10.0);
+        let near = probe.near_mm();
+        let mut seen = [0usize; 4];
+        for k in 0..4000 {
+            let p = Point3::new(6.0 * rnd(), 6.0 * rnd(), 0.3 - 1.3 * rnd());
+            let n = Vector3::new(0.2 * (rnd() - 0.5), 0.2 * (rnd() - 0.5), 1.0).normalize();
+            // Every other point through a focus round it (wide enough for the first look
+            // every time, for the look up to the reach only sometimes).
+            if k % 2 == 0 {
+                probe.focus(&p, 2.0 * near + 0.5 * r * rnd());
+            } else {
+                probe.unfocus();
+            }
+            let level = if k % 3 == 0 { 2.0 * near } else { 0.5 * near };
+            let reading = probe.read_against(&p, &n, level);
+            probe.unfocus();
+            let measured = probe.measure(&p, &n);
+            match (reading, measured) {
+                (Reading::Swept, Material::Left { left_mm, .. }) if left_mm <= 0.0 => seen[0] += 1,
+                (Reading::Left(t), Material::Left { left_mm, .. }) if t == left_mm && t > 0.0 => {
+                    seen[1] += 1
+                }
+                (Reading::Over, Material::Left { left_mm, .. }) if left_mm > level => seen[2] += 1,
+                (Reading::Unreached, Material::Unreached) => seen[3] += 1,
+                (got, m) => panic!("at {p:?} against {level} mm: read {got:?}, measured {m:?}"),
+            }
+        }
+        assert!(seen.iter().all(|&c| c > 50), "{seen:?}");
     }
 }
