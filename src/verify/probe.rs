@@ -150,15 +150,13 @@ impl<'a> Probe<'a> {
         self.hits.clear();
         let (a, b) = (p + n * lo, p + n * hi);
         let (caps, r) = (self.capsules, self.radius);
-        if let Some(f) = &self.focus {
-            if (a - f.centre).norm() <= f.radius && (b - f.centre).norm() <= f.radius {
-                for &i in &f.capsules {
-                    if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
-                        self.hits.push((i, h));
-                    }
+        if let (Some(f), true) = (&self.focus, self.focused(&a, &b)) {
+            for &i in &f.capsules {
+                if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
+                    self.hits.push((i, h));
                 }
-                return;
             }
+            return;
         }
         self.next_stamp();
         let hits = &mut self.hits;
@@ -227,10 +225,10 @@ impl<'a> Probe<'a> {
     /// overlapping balls; a long look along the normal). Material left up to `level` is
     /// measured as [`Probe::measure`] does.
     pub fn read_against(&mut self, p: &Point3, n: &Vector3, level: f64) -> Reading {
+        self.depth = None;
         if self.gather_unless_swept(p, n) {
             return Reading::Swept;
         }
-        self.depth = None;
         let near = self.near_mm();
         // As `measure`: nothing contains `p`, so the first capsule entered decides.
         if let Some(t) = self
@@ -409,7 +407,8 @@ impl<'a> Probe<'a> {
     }
 
     /// The [`Probe::straight_depth`] of the point the last [`Probe::measure`] found swept
-    /// (`None` if it was not), found from the same look.
+    /// (`None` if it was not, or a [`Probe::read_against`] came after it), found from the
+    /// same look.
     pub fn last_straight_depth(&self) -> Option<f64> {
         self.depth
     }
@@ -420,23 +419,32 @@ mod tests {
     use super::*;
     use crate::geom::Aabb;
 
+    /// The box the scattered moves lie in, with room round them (mm).
+    const REGION: Aabb = Aabb {
+        min: [-2.0, -2.0, -3.0],
+        max: [8.0, 8.0, 3.0],
+    };
+
+    /// `count` random straight moves of balls of radius `r` over a 6 mm square, their
+    /// lowest points from 0.3 mm below to 0.9 mm above Z 0.
+    fn scattered(rnd: &mut impl FnMut() -> f64, count: usize, r: f64) -> Vec<Capsule> {
+        (0..count)
+            .map(|_| {
+                let a = Point3::new(6.0 * rnd(), 6.0 * rnd(), r - 0.3 + 1.2 * rnd());
+                let d = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 * (rnd() - 0.5)) * 2.0;
+                Capsule::new(a, a + d)
+            })
+            .collect()
+    }
+
     /// The measurement equals a brute force over every capsule: the first entry above the
     /// point, or the bottom of the swept region containing it.
     #[test]
     fn agrees_with_brute_force_over_all_capsules() {
         let mut rnd = crate::testing::uniform(777u64);
         let r = 0.5;
-        let mut capsules = Vec::new();
-        for _ in 0..300 {
-            let a = Point3::new(6.0 * rnd(), 6.0 * rnd(), r - 0.3 + 1.2 * rnd());
-            let d = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 * (rnd() - 0.5)) * 2.0;
-            capsules.push(Capsule::new(a, a + d));
-        }
-        let region = Aabb {
-            min: [-2.0, -2.0, -3.0],
-            max: [8.0, 8.0, 3.0],
-        };
-        let index = CapsuleIndex::build(&capsules, r, &region, 0.5 * r);
+        let capsules = scattered(&mut rnd, 300, r);
+        let index = CapsuleIndex::build(&capsules, r, &REGION, 0.5 * r);
         let mut probe = Probe::new(&capsules, &index, r, r, 10.0);
         let (mut gouges, mut left, mut unreached) = (0, 0, 0);
         for _ in 0..3000 {
@@ -498,17 +506,8 @@ mod tests {
     fn reading_against_a_level_agrees_with_the_measurement() {
         let mut rnd = crate::testing::uniform(4711u64);
         let r = 0.5;
-        let mut capsules = Vec::new();
-        for _ in 0..400 {
-            let a = Point3::new(6.0 * rnd(), 6.0 * rnd(), r - 0.3 + 1.2 * rnd());
-            let d = Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.3 * (rnd() - 0.5)) * 2.0;
-            capsules.push(Capsule::new(a, a + d));
-        }
-        let region = Aabb {
-            min: [-2.0, -2.0, -3.0],
-            max: [8.0, 8.0, 3.0],
-        };
-        let index = CapsuleIndex::build(&capsules, r, &region, 0.5 * r);
+        let capsules = scattered(&mut rnd, 400, r);
+        let index = CapsuleIndex::build(&capsules, r, &REGION, 0.5 * r);
         let mut probe = Probe::new(&capsules, &index, r, r, 10.0);
         let near = probe.near_mm();
         let mut seen = [0usize; 4];
