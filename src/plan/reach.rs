@@ -337,7 +337,8 @@ fn touching_lifted(
     let key = |p: &[f64; 3], cell: f64| p.map(|x| (x / cell).floor() as i64);
     let mut out = Vec::new();
     // Each lifted contact in its cell (a reach wide) and the 26 around it.
-    let cell = reach.max(1e-9);
+    // The reach is at least the tool radius, which the options hold positive.
+    let cell = reach;
     let mut grid: Grid = Default::default();
     for k in 0..lifted.len() {
         let c = key(&contact(k).into(), cell);
@@ -380,7 +381,7 @@ fn touching_lifted(
     let mut spheres: Vec<f64> = lifted_extent.iter().map(|&e| radius(e)).collect();
     let mid = spheres.len() / 2;
     let median = *spheres.select_nth_unstable_by(mid, f64::total_cmp).1;
-    let fine = (2.0 * median).max(reach / FINE_CELLS_PER_REACH).max(1e-9);
+    let fine = (2.0 * median).max(reach / FINE_CELLS_PER_REACH);
     let cells = |c: &Point3, r: f64| {
         let (lo, hi) = (
             key(&[c.x - r, c.y - r, c.z - r], fine),
