@@ -5,7 +5,7 @@
 //! taken with the textbook limit masks, and compared with the library's evaluation at the
 //! same dyadic parameters.
 
-mod support;
+use crate::support;
 
 use std::collections::HashMap;
 use support::{bumpy_sheet, crease_tag};

@@ -3,7 +3,7 @@
 //! detours as eq. 10–13 state them, and the cut checked by the cutting simulation — with
 //! the plain curve as the baseline the paper improves on.
 
-mod support;
+use crate::support;
 
 use std::collections::{HashMap, HashSet};
 use support::{holed_samples, isfc_opts as opts, public_tsm};

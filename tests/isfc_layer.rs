@@ -3,7 +3,7 @@
 //! per tree link between the centres of the cells it joins, and the layer a plan keeps is the
 //! layer of the curve it was planned from.
 
-mod support;
+use crate::support;
 
 use std::collections::HashMap;
 use support::{holed_samples, isfc_opts as opts};

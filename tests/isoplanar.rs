@@ -3,7 +3,7 @@
 //! the cutting simulation on the keycaps, the closed head (five-axis), the public bicycle
 //! seat and an OBJ cage, against the constant-spacing baseline.
 
-mod support;
+use crate::support;
 
 use support::{extruded_obj, obj_model, public_tsm};
 use tspath::geom::Point3;

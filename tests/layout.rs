@@ -1,7 +1,7 @@
 //! Patch layouts: counts, coverage, rectangular charts whose evaluation matches the faces
 //! (derivatives against differences), extraordinary points at patch corners, connections.
 
-mod support;
+use crate::support;
 
 use tspath::layout::ConnectionKind;
 use tspath::model::samples::{self, SAMPLES};

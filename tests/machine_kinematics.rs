@@ -1,7 +1,7 @@
 //! Kinematics against closed forms, forward ∘ inverse on every machine, continuity of the
 //! rotaries across the singular pose, unwinding, and limit errors.
 
-mod machine_support;
+use crate::machine_support;
 
 use machine_support::*;
 use tspath::geom::{Point3, Vector3};

@@ -14,7 +14,7 @@
 // Index loops over X Y Z A B C read like the axes they compare.
 #![allow(clippy::needless_range_loop)]
 
-mod machine_support;
+use crate::machine_support;
 
 use machine_support::*;
 use tspath::machine::{self, post, reader, Dialect, Units, MACHINES};

@@ -3,7 +3,7 @@
 //! trunnion with A ±120°, or wrote as `A133.0480` on a machine with A ±180°). Every move of
 //! closed parts planned five-axis is checked, and the program posted on the trunnion.
 
-mod support;
+use crate::support;
 
 use support::{obj_model, torus_obj};
 use tspath::machine::{self, Dialect, JobInfo, Units};

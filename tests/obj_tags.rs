@@ -4,7 +4,7 @@
 //! the ball off them as off a `.tsm` crease. (Semi-sharp creases against explicit
 //! subdivision: `tests/catmull_clark.rs`.)
 
-mod support;
+use crate::support;
 
 use support::{bumpy_sheet, crease_tag};
 

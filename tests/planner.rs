@@ -5,7 +5,7 @@
 //! tool axes checked by an independent distance test, also while the axis turns between cut
 //! points.
 
-mod support;
+use crate::support;
 
 use support::{cylinder_distance, dense_samples, tool_clearance, SampleGrid};
 use tspath::geom::{Point3, Vector3};

@@ -4,7 +4,7 @@
 //! measured by the cutting simulation with enough samples for its error bound to prove the
 //! scallop (a quarter of it).
 
-mod support;
+use crate::support;
 
 use support::{
     dense_samples, extruded_obj, obj_model, public_tsm, tool_clearance, torus_obj, SampleGrid,

@@ -6,7 +6,7 @@
 //! The fuzz test runs `DEFAULT_FUZZ_CASES` cases per format; `TSPATH_FUZZ_CASES=N` (or
 //! proptest's own `PROPTEST_CASES=N`) runs more.
 
-mod support;
+use crate::support;
 
 use proptest::prelude::*;
 use serde_json::{json, Value};

@@ -1,7 +1,7 @@
 //! Local refinement: inserting knot lines leaves the surface unchanged (compared point by
 //! point in the global parameter chart) and changes the control net as knot insertion must.
 
-mod support;
+use crate::support;
 
 use support::chart_point as at;
 use tspath::model::samples;

@@ -2,7 +2,7 @@
 //! turns and the table. Each is a similarity of the control points, so every surface point
 //! moves exactly with it: checked point by point, on bounding boxes, and through the CLI.
 
-mod support;
+use crate::support;
 
 use support::extruded_obj;
 use tspath::geom::Point3;

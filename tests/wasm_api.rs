@@ -1,6 +1,4 @@
-//! The exported JavaScript API, run as wasm in headless Node by wasm-bindgen-test-runner:
-//! `cargo test --target wasm32-unknown-unknown --test wasm_api` (see scripts/test).
-#![cfg(target_arch = "wasm32")]
+//! The exported JavaScript API, as JavaScript sees it (a module of `tests/wasm.rs`).
 
 use tspath::wasm::{sample_names, WasmModel as Model};
 use wasm_bindgen::{JsCast, JsValue};

@@ -1,6 +1,4 @@
-//! The verification API as JavaScript sees it, run as wasm in headless Node:
-//! `cargo test --target wasm32-unknown-unknown --test wasm_verify`.
-#![cfg(target_arch = "wasm32")]
+//! The verification API as JavaScript sees it (a module of `tests/wasm.rs`).
 
 use tspath::wasm::WasmModel as Model;
 use wasm_bindgen::{JsCast, JsValue};

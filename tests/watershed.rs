@@ -3,7 +3,7 @@
 //! the baseline's single direction, determinism, and the error on a domain that does not
 //! lie flat.
 
-mod support;
+use crate::support;
 
 use support::public_tsm;
 use tspath::model::samples;

@@ -49,41 +49,55 @@ const SAMPLES = runCli(['sample', '--list']).stdout.trim().split('\n').map((l) =
 const GRAPETEC = join(root, 'www', 'models', 'grapetec');
 const PUBLIC_TSM = readdirSync(GRAPETEC).filter((f) => f.endsWith('.tsm')).sort();
 
-/** Plans with the CLI: the report, the program, the exit status (3: planned with problems)
- * and, with `samples`, the verification as the page runs it (`--verify --verify-samples N
- * --verify-max-samples M`). */
-function cliPlan(model, { toolRadius, scallop, machine = '3-axis', dialect = 'linuxcnc', units = 'mm', samples, maxSamples, extra = [] }) {
-  const stem = `${model.replace(/^.*\//, '')}-${machine}-${dialect}-${units}-${toolRadius}-${scallop}`;
+/** The CLI's arguments for a plan (and, with `samples`, the verification as the page runs
+ * it: `--verify --verify-samples N --verify-max-samples M`), and the stem of its outputs. */
+let cliRuns = 0;
+function cliPlanArgs(model, { toolRadius, scallop, machine = '3-axis', dialect = 'linuxcnc', units = 'mm', samples, maxSamples, extra = [] }) {
+  // Numbered: runs beside each other never share an output file.
+  const stem = `${model.replace(/^.*\//, '')}-${machine}-${dialect}-${units}-${toolRadius}-${scallop}-${cliRuns++}`;
   const args = ['plan', model, '--tool-radius', String(toolRadius), '--scallop', String(scallop),
     '--machine', machine, '--dialect', dialect, '--units', units, ...extra,
     '-o', `${stem}.nc`, '--report', `${stem}.json`];
   if (samples) args.push('--verify', '--verify-samples', String(samples));
   if (samples && maxSamples) args.push('--verify-max-samples', String(maxSamples));
-  const { status } = runCli(args, { problems: true });
+  return { args, stem };
+}
+
+/** The outputs of a CLI plan that exited with `status`: the report, the program, the status
+ * (3: planned with problems). */
+function cliOutputs(stem, status) {
   const report = JSON.parse(readFileSync(join(work, `${stem}.json`), 'utf8'));
   check((status === EXIT_PROBLEMS) === (report.status === 'planned_with_problems'),
     `the CLI exits ${status} for a plan whose status is ${report.status}`);
   return { report, status, gcode: readFileSync(join(work, `${stem}.nc`), 'utf8') };
 }
 
-/** As `cliPlan`, without waiting: the CLI runs beside the browser (a promise of the same). */
-function cliPlanAsync(model, { toolRadius, scallop, samples, maxSamples, extra = [] }) {
-  const stem = `${model.replace(/^.*\//, '')}-async-${toolRadius}-${scallop}`;
-  const args = ['plan', model, '--tool-radius', String(toolRadius), '--scallop', String(scallop),
-    ...extra, '-o', `${stem}.nc`, '--report', `${stem}.json`];
-  if (samples) args.push('--verify', '--verify-samples', String(samples));
-  if (samples && maxSamples) args.push('--verify-max-samples', String(maxSamples));
-  return new Promise((resolve, reject) => {
+/** Plans with the CLI and waits for it (options as `cliPlanArgs`). */
+function cliPlan(model, options) {
+  const { args, stem } = cliPlanArgs(model, options);
+  return cliOutputs(stem, runCli(args, { problems: true }).status);
+}
+
+/** As `cliPlan`, without waiting: the CLI runs beside the browser, which leaves a core idle
+ * while its worker plans (a promise of the same; it never rejects unhandled). */
+function cliPlanAsync(model, options) {
+  const { args, stem } = cliPlanArgs(model, options);
+  const done = new Promise((resolve, reject) => {
     execFile(cli, args, { cwd: work, maxBuffer: 1 << 28 }, (err, stdout, stderr) => {
       const status = err ? err.code : 0;
       if (status !== 0 && status !== EXIT_PROBLEMS) {
         reject(new Error(`tspath ${args.join(' ')} exited with ${status}: ${stderr.trim()}`));
         return;
       }
-      const report = JSON.parse(readFileSync(join(work, `${stem}.json`), 'utf8'));
-      resolve({ report, status, gcode: readFileSync(join(work, `${stem}.nc`), 'utf8') });
+      try {
+        resolve(cliOutputs(stem, status));
+      } catch (e) {
+        reject(e);
+      }
     });
   });
+  done.catch(() => {});
+  return done;
 }
 
 // ------------------------------------------------------------------ helpers
@@ -268,6 +282,7 @@ test('the page opens and draws the first model with WebGL', async (page, url) =>
 for (const name of SAMPLES) {
   test(`sample ${name}: loads, plans, shows the path, matches the CLI, G-code names the model`, async (page, url) => {
     const scallop = scallopOf(name);
+    const running = cliPlanAsync(name, { toolRadius: 0.5, scallop, samples: VERIFY_SAMPLES, maxSamples: VERIFY_MAX_SAMPLES });
     await page.goto(`${url}?model=${name}`);
     await page.waitForSelector(`${HOST}[data-model="${name}"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
     await setParam(page, 'scallop', scallop);
@@ -279,7 +294,7 @@ for (const name of SAMPLES) {
     check(pathPixels > 2000, `the path should be drawn: it changes only ${pathPixels} pixels`);
     const summary = await page.textContent('#summary');
 
-    const cli = cliPlan(name, { toolRadius: 0.5, scallop, samples: VERIFY_SAMPLES, maxSamples: VERIFY_MAX_SAMPLES });
+    const cli = await running;
     const r = cli.report;
     for (const id of ['cl_points', 'retractions', 'reversals', 'patches']) {
       const s = await stat(page, id);
@@ -725,6 +740,7 @@ test('the closed head, five-axis from the URL: cut all round, no gouge, same as 
   // A million samples (no growth: the cap is the start) give a finite error bound on the
   // faces round the extraordinary points; a bound of h/4 would take many more.
   const n = 1000000;
+  const running = cliPlanAsync('head', { toolRadius: 0.5, scallop: h, machine: 'table-table-ac', samples: n, maxSamples: n, extra: ['--max-tilt', '120'] });
   await page.goto(`${url}?model=head&machine=table-table-ac&max-tilt=120&scallop=${h}&samples=${n}&max-samples=${n}&plan=1`);
   await waitPlans(page, 1, 180000);
   await waitVerified(page, 120000);
@@ -737,7 +753,7 @@ test('the closed head, five-axis from the URL: cut all round, no gouge, same as 
   const sim = await stat(page, 'max_scallop_mm');
   const bound = await stat(page, 'error_bound_mm');
   check(Number.isFinite(bound.value) && sim.value <= h + bound.value, `simulated scallop ${sim.text} within ${h} mm + bound ${bound.text}`);
-  const cli = cliPlan('head', { toolRadius: 0.5, scallop: h, machine: 'table-table-ac', samples: n, maxSamples: n, extra: ['--max-tilt', '120'] });
+  const cli = await running;
   const r = cli.report;
   const cl = await stat(page, 'cl_points');
   const step = await stat(page, 'max_axis_step_deg');
@@ -776,6 +792,9 @@ async function checkPlanStats(page, r, what) {
 
 test('Bike.tsm (public file) plans at the page defaults and five-axis; rest area drawn; numbers as the CLI\'s', async (page, url) => {
   const file = join(GRAPETEC, 'Bike.tsm');
+  const threeRun = cliPlanAsync(file, { toolRadius: 0.5, scallop: 0.01, samples: VERIFY_SAMPLES, maxSamples: VERIFY_MAX_SAMPLES });
+  const fiveRun = threeRun.then(() => cliPlanAsync(file, { toolRadius: 0.5, scallop: 0.01, machine: 'table-table-ac', samples: VERIFY_SAMPLES, maxSamples: VERIFY_MAX_SAMPLES }));
+  fiveRun.catch(() => {});
   // The link to a public file opens it (as the picker does).
   await page.goto(`${url}?model=grapetec/Bike.tsm&${SIM}`);
   await page.waitForSelector(`${HOST}[data-model="Bike"][data-state="model-loaded"]`, { timeout: 30000, state: 'attached' });
@@ -787,7 +806,7 @@ test('Bike.tsm (public file) plans at the page defaults and five-axis; rest area
   await waitPlans(page, 1);
   await waitVerified(page);
   check(new URL(page.url()).searchParams.get('model') === 'grapetec/Bike.tsm', `the URL keeps the file: ${page.url()}`);
-  const three = cliPlan(file, { toolRadius: 0.5, scallop: 0.01, samples: VERIFY_SAMPLES, maxSamples: VERIFY_MAX_SAMPLES });
+  const three = await threeRun;
   await checkPlanStats(page, three.report, 'Bike, three-axis');
   const sim3 = await checkVerification(page, three.report.verify, 'Bike, three-axis');
   const rep3 = await checkReport(page, three.report, 'Bike, three-axis');
@@ -801,7 +820,7 @@ test('Bike.tsm (public file) plans at the page defaults and five-axis; rest area
   await page.click('#plan');
   await waitPlans(page, 2);
   await waitVerified(page);
-  const five = cliPlan(file, { toolRadius: 0.5, scallop: 0.01, machine: 'table-table-ac', samples: VERIFY_SAMPLES, maxSamples: VERIFY_MAX_SAMPLES });
+  const five = await fiveRun;
   await checkPlanStats(page, five.report, 'Bike, five-axis');
   const sim5 = await checkVerification(page, five.report.verify, 'Bike, five-axis');
   const rep5 = await checkReport(page, five.report, 'Bike, five-axis');
