@@ -89,6 +89,85 @@ fn a_y_up_cage_in_centimetres_lands_in_millimetres_z_up_on_the_table() {
 }
 
 #[test]
+fn an_obj_header_naming_its_unit_is_read_in_that_unit_unless_one_is_set() {
+    // OpenSubdiv's shapes (as Maya writes OBJ) open with "# This file uses centimeters as
+    // units for non-parametric coordinates.": read as written, the dart was 4 mm across.
+    let path = format!(
+        "{}/tests/fixtures/opensubdiv/catmark_dart_edgecorner.obj",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.starts_with("# This file uses centimeters as units"));
+    let width = |m: &tspath::Model| {
+        let b = m.surface.bbox();
+        b.max[0] - b.min[0]
+    };
+    let as_mm = ImportSetup {
+        model_units: Some(LengthUnit::Mm),
+        ..ImportSetup::default()
+    };
+    let written = io::load_with(text.as_bytes(), "dart", &as_mm).unwrap();
+    let read = io::load(text.as_bytes(), "dart").unwrap();
+    println!(
+        "dart: {:.3} mm across as written, {:.3} mm in its unit ({}; {})",
+        width(&written),
+        width(&read),
+        read.units_read,
+        read.placement
+    );
+    assert!((width(&read) - 10.0 * width(&written)).abs() <= 1e-9 * width(&read));
+    assert_eq!(read.units_read, "cm (the file's header comment)");
+    assert!(
+        read.placement.contains("numbers in cm"),
+        "{}",
+        read.placement
+    );
+    assert_eq!(written.units_read, "mm");
+    // The same numbers: every surface point ten times as far from the origin.
+    let mut worst: f64 = 0.0;
+    for (f, u, v) in face_samples(5, read.surface.faces().len()) {
+        let want = 10.0 * read_point(&written, f, u, v);
+        worst = worst.max((read.surface.subs(f, u, v).coords - want).norm());
+    }
+    assert!(worst <= 1e-12 * width(&read), "{worst:e}");
+    // Other spellings and units; a unit not listed, or a comment after the first record,
+    // leaves the file's numbers as mm (assumed).
+    for (header, want) in [
+        (
+            "# This file uses millimetres as units.",
+            "mm (the file's header comment)",
+        ),
+        (
+            "#\n# this file USES Inches AS units for coordinates",
+            "inch (the file's header comment)",
+        ),
+        (
+            "# This file uses meters as units",
+            "m (the file's header comment)",
+        ),
+        (
+            "# This file uses feet as units for non-parametric coordinates.",
+            "mm (assumed)",
+        ),
+        ("# written by hand", "mm (assumed)"),
+    ] {
+        let cage = format!("{header}\n{}", y_up_cage());
+        let m = io::load(cage.as_bytes(), "sheet").unwrap();
+        assert_eq!(m.units_read, want, "{header}");
+    }
+    let late = format!("{}# This file uses centimeters as units\n", y_up_cage());
+    assert_eq!(
+        io::load(late.as_bytes(), "sheet").unwrap().units_read,
+        "mm (assumed)"
+    );
+}
+
+/// A point of `m`'s surface, as a vector from the origin.
+fn read_point(m: &tspath::Model, f: usize, u: f64, v: f64) -> tspath::geom::Vector3 {
+    m.surface.subs(f, u, v).coords
+}
+
+#[test]
 fn bad_set_ups_are_refused_naming_what_to_change() {
     let dome = tspath::model::samples::sample_json("dome").unwrap();
     // The JSON file says mm: another unit is refused, the scale is the way to resize.

@@ -13,7 +13,7 @@
 export const PARAMS = [
   // Placement of the model (not plan options: the model is read again with them). As the
   // CLI's --model-units, --scale, --up, --rotate and --on-table.
-  { key: 'model-units', field: null, group: 'placement', placement: true, label: 'File\u2019s unit (for files that do not say: OBJ)', kind: 'choice', choices: [['', 'as the file says (OBJ: mm)'], ['mm', 'millimetres'], ['cm', 'centimetres'], ['m', 'metres'], ['inch', 'inches']], default: '' },
+  { key: 'model-units', field: null, group: 'placement', placement: true, label: 'File\u2019s unit (for files that do not say: OBJ)', kind: 'choice', choices: [['', 'as the file says (OBJ: its header comment, else mm)'], ['mm', 'millimetres'], ['cm', 'centimetres'], ['m', 'metres'], ['inch', 'inches']], default: '' },
   { key: 'scale', field: null, group: 'placement', placement: true, label: 'Scale', unit: '×', kind: 'number', min: 0.000001, max: 1000000, step: 0.1, default: 1 },
   { key: 'up', field: null, group: 'placement', placement: true, label: 'The file\u2019s up axis', kind: 'choice', choices: [['z', '+Z (machines)'], ['y', '+Y (most modelling tools): turned to +Z']], default: 'z' },
   { key: 'rotate', field: null, group: 'placement', placement: true, label: 'Turn about Z (counter-clockwise from above)', unit: '°', kind: 'choice', choices: [['0', '0°'], ['90', '90°'], ['180', '180°'], ['270', '270°']], default: '0' },

@@ -95,12 +95,21 @@ pub fn load_with(bytes: &[u8], name: &str, setup: &ImportSetup) -> Result<Model>
         }
         Format::Obj => {
             let text = String::from_utf8_lossy(bytes);
-            let units = match setup.model_units {
-                Some(u) => u.name().to_string(),
-                None => "mm (assumed)".to_string(),
+            // The unit set for the file wins; else the one its header comment names (Maya's
+            // export, OpenSubdiv's shapes); else mm.
+            let (units, setup) = match (setup.model_units, obj::unit_comment(&text)) {
+                (Some(u), _) => (u.name().to_string(), *setup),
+                (None, Some(u)) => (
+                    format!("{} (the file's header comment)", u.name()),
+                    ImportSetup {
+                        model_units: Some(u),
+                        ..*setup
+                    },
+                ),
+                (None, None) => ("mm (assumed)".to_string(), *setup),
             };
             let (mesh, warnings) = obj::read(&text)?;
-            let mut m = Model::try_new_placed(name, "obj", &units, mesh, setup, None)?;
+            let mut m = Model::try_new_placed(name, "obj", &units, mesh, &setup, None)?;
             m.warnings = warnings;
             Ok(m)
         }

@@ -20,6 +20,7 @@
 
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector4};
+use crate::model::setup::LengthUnit;
 use crate::surface::sharpness::{self, EdgeEnd, INFINITELY_SHARP};
 use crate::tmesh::{
     control_point_problem, BoundaryInterpolation, ControlPoint, FaceLoop, Scheme, SubdivTags, TMesh,
@@ -31,7 +32,38 @@ const FORMAT: &str = "obj";
 /// The subdivision tags OBJ cages from modelling tools carry (as OpenSubdiv reads them).
 const KNOWN_TAGS: [&str; 4] = ["crease", "corner", "interpolateboundary", "hole"];
 
-/// Reads an OBJ cage with its subdivision tags. Coordinates are taken as millimetres. Returns
+/// The unit a header comment names, as Maya writes it ("# This file uses centimeters as units
+/// for non-parametric coordinates."; OpenSubdiv's shapes carry it): looked for in the comment
+/// lines before the first record. `None` where no comment says, or names a unit not listed
+/// in [`LengthUnit`].
+pub fn unit_comment(text: &str) -> Option<LengthUnit> {
+    let comments = text
+        .lines()
+        .map(str::trim)
+        .take_while(|l| l.is_empty() || l.starts_with('#'));
+    comments
+        .filter_map(|l| {
+            let words: Vec<&str> = l
+                .trim_start_matches('#')
+                .split_whitespace()
+                .map(|w| w.trim_matches(|c: char| !c.is_alphabetic()))
+                .collect();
+            let at = words.windows(3).position(|w| {
+                w[0].eq_ignore_ascii_case("uses") && w[2].eq_ignore_ascii_case("as")
+            })?;
+            (words.get(at + 3)?.eq_ignore_ascii_case("units")).then(|| words[at + 1])
+        })
+        .find_map(|unit| match unit.to_ascii_lowercase().as_str() {
+            "millimeters" | "millimetres" | "millimeter" | "millimetre" => Some(LengthUnit::Mm),
+            "centimeters" | "centimetres" | "centimeter" | "centimetre" => Some(LengthUnit::Cm),
+            "meters" | "metres" | "meter" | "metre" => Some(LengthUnit::M),
+            "inches" | "inch" => Some(LengthUnit::Inch),
+            _ => None,
+        })
+}
+
+/// Reads an OBJ cage with its subdivision tags. Coordinates are returned as written (the
+/// loader scales them by the unit: [`unit_comment`] or the one set). Returns
 /// the mesh and the warnings reading it gave (none at present).
 ///
 /// Errors name the line at fault, with vertices numbered as in the file (from 1): bad

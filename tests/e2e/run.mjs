@@ -1871,12 +1871,15 @@ test('a big cage from another tool (OpenSubdiv\'s car body, 1 575 faces with cre
   const tags = (await page.textContent('#summary-subdivision-tags')).trim();
   check(patches === 552, `552 patches: ${patches}`);
   check(/semi-sharp crease edges/.test(tags), `its creases are listed: “${tags}”`);
+  // Its header says centimetres (as Maya writes OBJ): read so, and the summary says why.
+  const format = (await page.textContent('#summary-format')).trim();
+  check(format === 'obj (cm (the file\'s header comment))', `the unit from the header: “${format}”`);
   const legend = await page.evaluate((h) => {
     const el = document.querySelector(h).shadowRoot.getElementById('patch-legend');
     return { swatches: el.querySelectorAll('.swatch').length, text: el.textContent };
   }, HOST);
   check(legend.swatches > 0 && legend.swatches <= 12 && /552 patches/.test(legend.text), `a compact legend: ${legend.swatches} swatches, “${legend.text.slice(0, 80)}”`);
-  return `loaded and tessellated in ${ms} ms; “${tags}”; legend “${legend.text.slice(0, 60)}…”`;
+  return `loaded and tessellated in ${ms} ms; format “${format}”; “${tags}”; legend “${legend.text.slice(0, 60)}…”`;
 });
 
 test('accessibility: axe-core finds no serious or critical violation on the main page, planned, nor on the embed', async (page, url) => {
