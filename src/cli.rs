@@ -46,9 +46,10 @@ const USAGE: &str = "usage:
 MODEL is a model file (.json, .tsm, .obj) or the name of a built-in sample. Every command
 that reads a MODEL places it with [--model-units mm|cm|m|inch] (the unit of a file that
 does not say its own, OBJ; default: the unit its header comment names, else mm)
-[--scale F] [--up z|y] (y: the file's +Y becomes +Z, as modelling tools write) [--rotate 0|90|180|270] (about +Z, counter-clockwise from above)
-[--on-table] (lowest point at Z 0) [--stock-side MM] [--stock-top MM] (stock beyond the
-part's box in X/Y and above it; its bottom is the part's lowest point) [--zero WHERE]
+[--scale F] [--up z|y] (y: the file's +Y becomes +Z, as modelling tools write)
+[--rotate 0|90|180|270] (about +Z, counter-clockwise from above) [--on-table] (lowest
+point at Z 0) [--stock-side MM] [--stock-top MM] (stock beyond the part's box in X/Y and
+above it; its bottom is the part's lowest point) [--zero WHERE]
 (the program's X0 Y0 Z0: model (default, the model's origin), stock-top-centre,
 stock-top-corner, stock-bottom-centre, stock-bottom-corner (front-left: least X, Y), or a
 point x,y,z in mm of the placed model); `info` shows the placement, the millimetre box
