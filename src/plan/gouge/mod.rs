@@ -126,9 +126,9 @@ pub fn lift(
         // The first cut point after an approach is lifted only off a surface facing it
         // (within 60° of its own normal): at a fold, moving it away from the nearest point
         // would take it to the far side, and the move to the next lifted point through.
-        let own_side = (m.kind == MoveKind::Plunge).then(|| m.cl_point - m.cc_point);
+        let away = m.cl_point - m.cc_point;
+        let own_side = (m.kind == MoveKind::Plunge).then_some(away);
         let Some(l) = near.nearest_from(&m.cl_point, r, &[]).and_then(|first| {
-            let away = m.cl_point - m.cc_point;
             lift_one(
                 &near,
                 m.cl_point,
