@@ -1771,7 +1771,9 @@ export class TspathPlanner extends HTMLElement {
     }
     const bound = plan.options.scallop_mm * VERIFY_BOUND_SHARE;
     const cap = values['max-samples'];
-    const what = ` Simulating the cut (from at least ${int(start)} samples until its error bound is ${mm(bound, 4)}, at most ${int(cap)} samples)…`;
+    // Short enough that the progress after it stays within the status's two lines (the
+    // sample counts are in the settings and, once simulated, in the results).
+    const what = ` Simulating the cut until its error bound is ${mm(bound, 4)}…`;
     // An error shown meanwhile (a value typed during the preview) stays until the user acts.
     const erring = () => this.$('status').classList.contains('error');
     if (!erring()) this.#planStatus(what);

@@ -479,9 +479,16 @@ test('progressive simulation: at the page defaults the short simulation of the k
     new MutationObserver(() => {
       if (el.getAttribute('data-preview') === 'shown') window.previewSeen = true;
     }).observe(el, { attributes: true, attributeFilter: ['data-preview'] });
+    // Every size the view takes (each change draws the scene again: in software rendering
+    // 200–300 ms, while the simulation waits for the CPU).
+    window.viewSizes = [];
+    new ResizeObserver(([e]) => window.viewSizes.push(`${Math.round(e.contentRect.width)}×${Math.round(e.contentRect.height)}`))
+      .observe(el.shadowRoot.getElementById('view'));
   }, HOST);
   await waitVerified(page, 120000);
   check(!(await page.evaluate(() => window.previewSeen)), 'no preview before a short simulation');
+  const sizes = await page.evaluate(() => window.viewSizes);
+  check(sizes.length >= 1 && sizes.every((z) => z === sizes[0]), `the view keeps its size while the status tells the progress: ${sizes.join(', ')}`);
   const quick = {
     samples: (await stat(page, 'samples')).text,
     fromPlan: Number(await attr(page, 'data-plan-to-final-ms')),
@@ -521,7 +528,7 @@ test('progressive simulation: at the page defaults the short simulation of the k
   const samples = (await stat(page, 'samples')).text;
   const fromPlan = Number(await attr(page, 'data-plan-to-final-ms'));
   check(fromPlan > 0 && fromPlan <= tFinal, `Plan to final heat map ${fromPlan} ms, within the ${tFinal} ms from navigation`);
-  return `defaults: from Plan to the final map ${quick.fromPlan} ms (planning ${quick.plan}, simulation ${quick.sim}, ${quick.samples} samples), no preview; h 0.003 mm: preview heat map after ${tPreview} ms from navigation, final after ${tFinal} ms (${samples} samples)`;
+  return `view ${sizes[0]} px throughout; defaults: from Plan to the final map ${quick.fromPlan} ms (planning ${quick.plan}, simulation ${quick.sim}, ${quick.samples} samples), no preview; h 0.003 mm: preview heat map after ${tPreview} ms from navigation, final after ${tFinal} ms (${samples} samples)`;
 });
 
 /** Drops a file on the view, as a user drags one from the desktop. */
