@@ -1270,6 +1270,7 @@ export class TspathPlanner extends HTMLElement {
       return;
     }
     const options = this.#planOptions(v.values);
+    // The program comes with the plan, for the machine, dialect and units asked for now.
     const post = { machine: v.values.machine, dialect: v.values.dialect, units: v.values.units };
     const token = (this.planToken = (this.planToken || 0) + 1);
     this.planning = true;
@@ -1285,7 +1286,7 @@ export class TspathPlanner extends HTMLElement {
     const t0 = performance.now();
     let result;
     try {
-      result = await this.client.call('plan', [options], (f) => {
+      result = await this.client.call('plan', [options, post], (f) => {
         if (token !== this.planToken) return;
         bar.value = f;
         this.#status(`Planning… ${Math.round(100 * f)} % (${((performance.now() - t0) / 1000).toFixed(1)} s)`);
@@ -1305,8 +1306,9 @@ export class TspathPlanner extends HTMLElement {
 
   /** Makes a planned result (from `plan`, or a compared row from `pick`) the plan shown:
    * path, layers, statistics, program, URL, then its simulation. */
-  async #adopt(result, options, values, t0) {
+  async #adopt(answer, options, values, t0) {
     this.#clearPlan();
+    const { program, programError, ...result } = answer;
     // `report` is what the page shows: the plan's own (`planReport`), and once simulated
     // the same with the simulation's findings added.
     this.plan = { ...result, planReport: result.report, options, values, workerHasPlan: true, startedAt: t0 };
@@ -1327,17 +1329,30 @@ export class TspathPlanner extends HTMLElement {
     this.dataset.status = result.report.status;
     this.dataset.verify = 'pending';
     this.#planStatus();
-    // From Plan to the plan shown: what "re-plan when fast" goes by (not the program).
-    this.lastPlanMs = performance.now() - t0;
+    // From Plan to the plan shown: what "re-plan when fast" goes by (not the program, though
+    // written with it).
+    this.lastPlanMs = performance.now() - t0 - (program?.ms || 0);
     const again = this.replanAfter && !this.#planMatches();
     this.replanAfter = false;
-    // The program first; the simulation is asked for as soon as the worker answers, before
-    // the page takes the program in, so the worker waits one message, not for the page. (Not
-    // both at once: a Cancel of the simulation would lose the program with the worker.)
+    // The program first, then the simulation (not both asked for at once: a Cancel of the
+    // simulation would lose the program with the worker). A plan from Plan brings its program
+    // for the machine, dialect and units asked for with it, and the simulation is asked for
+    // at once (waiting for a separate answer, the worker waited 120–200 ms for the page,
+    // busy drawing the path); one picked from a comparison asks for its program, and the
+    // simulation as soon as the worker answers, before the page takes the program in.
     const plan = this.plan;
-    await this.#post(() => {
-      if (!again && plan === this.plan && !this.planning) this.#verify();
-    });
+    const choice = this.#programChoice();
+    const asked = choice.every((x, i) => x === [values.machine, values.dialect, values.units][i]);
+    if (asked && (program || programError)) {
+      if (program) this.#takeProgram(plan, program, ...choice);
+      else this.#programFailed(plan, choice[0], choice[1], programError);
+      this.#updateDownloads();
+      if (!again) this.#verify();
+    } else {
+      await this.#post(() => {
+        if (!again && plan === this.plan && !this.planning) this.#verify();
+      });
+    }
     this.dataset.plans = String(Number(this.dataset.plans || 0) + 1);
     // Where the slider is: 0 for a new plan, unless it was moved while the program was
     // being written.
@@ -1665,7 +1680,7 @@ export class TspathPlanner extends HTMLElement {
     if (!this.plan || this.plan.workerHasPlan) return true;
     this.#status('Restoring the plan in the engine…');
     try {
-      await this.client.call('plan', [this.plan.options]);
+      await this.client.call('plan', [this.plan.options, null]);
       this.plan.workerHasPlan = true;
       return true;
     } catch (e) {
@@ -1681,7 +1696,7 @@ export class TspathPlanner extends HTMLElement {
   async #post(answered = null) {
     if (!this.plan) return;
     const plan = this.plan;
-    const [machine, dialect, units] = ['machine', 'dialect', 'units'].map((k) => this.$(`p-${k}`).value);
+    const [machine, dialect, units] = this.#programChoice();
     this.posting = (this.posting || 0) + 1;
     this.#updateDownloads();
     try {
@@ -1691,26 +1706,42 @@ export class TspathPlanner extends HTMLElement {
         (e) => { if (!(e instanceof CancelledError)) answered?.(); throw e; },
       );
       if (plan !== this.plan) return;
-      plan.gcode = { ...g, machine, dialect, units, lineStarts: null, lineCount: 0 };
-      // The machining time on this machine (the simulation's report keeps its other keys).
-      for (const r of [plan.report, plan.planReport]) Object.assign(r, g.time);
-      this.#showStats();
-      this.#indexLines(plan.gcode);
-      this.$('listing-title').textContent = `G-code: ${machine}, ${dialect}, ${units}`;
-      this.$('p-machine').removeAttribute('aria-invalid');
-      this.$('p-dialect').removeAttribute('aria-invalid');
-      this.#scrubTo(Number(this.$('scrub').value));
-      if (this.$('status').classList.contains('error') && !this.#validateAll().errors) this.#planStatus(' Program written.');
+      this.#takeProgram(plan, g, machine, dialect, units);
     } catch (e) {
       if (e instanceof CancelledError || plan !== this.plan) return;
-      plan.gcode = null;
-      this.$('listing').replaceChildren();
-      this.$('listing-title').textContent = 'G-code';
-      this.#status(`Could not write the program for ${machine} in ${dialect}: ${e.message}`, true);
+      this.#programFailed(plan, machine, dialect, e.message);
     } finally {
       this.posting--;
       this.#updateDownloads();
     }
+  }
+
+  /** The machine, dialect and units chosen for the program. */
+  #programChoice() {
+    return ['machine', 'dialect', 'units'].map((k) => this.$(`p-${k}`).value);
+  }
+
+  /** Takes in the program `g` of `plan` (the plan shown) written for a machine, dialect and
+   * units: listing, machining time, the tool's block. */
+  #takeProgram(plan, g, machine, dialect, units) {
+    plan.gcode = { ...g, machine, dialect, units, lineStarts: null, lineCount: 0 };
+    // The machining time on this machine (the simulation's report keeps its other keys).
+    for (const r of [plan.report, plan.planReport]) Object.assign(r, g.time);
+    this.#showStats();
+    this.#indexLines(plan.gcode);
+    this.$('listing-title').textContent = `G-code: ${machine}, ${dialect}, ${units}`;
+    this.$('p-machine').removeAttribute('aria-invalid');
+    this.$('p-dialect').removeAttribute('aria-invalid');
+    this.#scrubTo(Number(this.$('scrub').value));
+    if (this.$('status').classList.contains('error') && !this.#validateAll().errors) this.#planStatus(' Program written.');
+  }
+
+  /** The program of `plan` (the plan shown) could not be written: says why. */
+  #programFailed(plan, machine, dialect, message) {
+    plan.gcode = null;
+    this.$('listing').replaceChildren();
+    this.$('listing-title').textContent = 'G-code';
+    this.#status(`Could not write the program for ${machine} in ${dialect}: ${message}`, true);
   }
 
   /** Where each line of the program starts, for showing a window of it. */

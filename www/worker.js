@@ -53,6 +53,17 @@ function progressTo(id) {
   };
 }
 
+/** The program of the current plan for a machine, dialect and units: its text, the line of
+ * each move in it and the machining time on that machine. */
+function program(machine, dialect, units) {
+  // The lines first: they post the program once and keep it for gcodeFor.
+  const lines = plan.gcodeLines(machine, dialect, units);
+  const text = plan.gcodeFor(machine, dialect, units);
+  plan.timeOn(machine);
+  const { machining_time_min: minutes, time_machine: timeMachine, notes } = plan.report();
+  return { text, lines, time: { machining_time_min: minutes, time_machine: timeMachine, notes } };
+}
+
 /** The current plan as the page draws it: report, points, kinds, rest area and layers. */
 function planResult() {
   const report = plan.report();
@@ -127,12 +138,27 @@ const ops = {
     }
   },
 
-  /** Plans with `options` (PlanOptions fields), reporting progress under request `id`. */
-  async plan(options, id) {
+  /** Plans with `options` (PlanOptions fields), reporting progress under request `id`; with
+   * `post` ({machine, dialect, units}) the answer holds the program too (`program`, as `post`
+   * answers, or `programError`), so the page can ask for the simulation as soon as it has the
+   * plan. */
+  async plan(options, post, id) {
     if (!model) throw new Error('no model is loaded');
     plan = free(plan);
     plan = model.plan(options, progressTo(id));
-    return planResult();
+    const answer = planResult();
+    if (post) {
+      const t0 = performance.now();
+      try {
+        answer.result.program = program(post.machine, post.dialect, post.units);
+        // How long writing it took (ms): not planning, for the page's "re-plan when fast".
+        answer.result.program.ms = performance.now() - t0;
+        answer.transfer.push(answer.result.program.lines.buffer);
+      } catch (e) {
+        answer.result.programError = e && e.message ? e.message : String(e);
+      }
+    }
+    return answer;
   },
 
   /** Compares strategies (`strategies`: comma-separated, all when empty) on the model with
@@ -160,13 +186,8 @@ const ops = {
   /** The program for a machine, dialect and units, and the line of each move in it. */
   async post(machine, dialect, units) {
     if (!plan) throw new Error('nothing is planned');
-    // The lines first: they post the program once and keep it for gcodeFor.
-    const lines = plan.gcodeLines(machine, dialect, units);
-    const text = plan.gcodeFor(machine, dialect, units);
-    // The machining time on the machine the program is for.
-    plan.timeOn(machine);
-    const { machining_time_min: minutes, time_machine: timeMachine, notes } = plan.report();
-    return { result: { text, lines, time: { machining_time_min: minutes, time_machine: timeMachine, notes } }, transfer: [lines.buffer] };
+    const result = program(machine, dialect, units);
+    return { result, transfer: [result.lines.buffer] };
   },
 
   /** Cutting simulation of the plan (`options`: samples, bound_mm, max_samples): summary,

@@ -1634,7 +1634,7 @@ test('a saved job reopens in a fresh browser to the same plan: the same G-code b
   return `job ${job.bytes.length} bytes; reopened in a fresh profile: G-code ${g2.length} bytes, equal; broken job: “${st.slice(0, 60)}…”`;
 });
 
-test('races: the tool and the listing follow the slider moved while the program is written; an error shown during the simulation stays; the program stays after a Cancel of the simulation or a failed load', async (page, url) => {
+test('races: the program comes with the plan; the tool and the listing follow the slider moved while the program is written again; an error shown during the simulation stays; the program stays after a Cancel of the simulation or a failed load', async (page, url) => {
   await page.goto(`${url}?model=dome&scallop=0.05&${SIM}`);
   await waitState(page, 'model-loaded');
   await page.uncheck('#auto');
@@ -1648,18 +1648,24 @@ test('races: the tool and the listing follow the slider moved while the program 
   });
   await page.click('#plan');
   await page.waitForSelector(`${HOST}[data-state="planned"]`, { state: 'attached' });
-  // Moved while the program is still being written.
+  // The program came with the plan: no separate request for it.
+  const brought = await host(page, (el) => !!el.plan.gcode && !el.posting);
+  check(brought, 'the program is there as soon as the plan is shown');
+  await waitPlans(page, 1);
+  // Written again in inches (held back), the slider moved meanwhile.
+  await setParam(page, 'units', 'inch');
   const to = await host(page, (el) => {
     const s = el.shadowRoot.getElementById('scrub');
     s.value = String(Math.floor(Number(s.max) / 2));
     s.dispatchEvent(new Event('input'));
     return Number(s.value);
   });
-  await waitPlans(page, 1);
+  await page.waitForFunction((h) => document.querySelector(h).plan.gcode?.units === 'inch', HOST);
   const after = await host(page, (el) => ({ move: Number(el.dataset.move), slider: Number(el.shadowRoot.getElementById('scrub').value), line: Number(el.shadowRoot.getElementById('listing').dataset.line), lineOf: el.plan.gcode.lines[Number(el.dataset.move)] }));
   check(after.move === to && after.slider === to, `the tool stays where the slider was moved (${JSON.stringify(after)}, moved to ${to})`);
   check(after.line === after.lineOf && after.line > 1, `the listing shows the block of that move: ${JSON.stringify(after)}`);
   // A wrong value typed during the simulation: its error stays when the simulation ends.
+  await page.click('#plan');
   await page.waitForFunction((h) => document.querySelector(h).dataset.verify === 'running', HOST);
   await setParam(page, 'scallop', '-1');
   const err = await page.locator(`${HOST} >> #status`).textContent();
