@@ -52,8 +52,7 @@ export class View3D {
     // Drawn on the CPU, multisampling adds to the work of every frame (the keycap's path:
     // 187 ms of the GPU process with it, 112 ms without, the page held meanwhile), so there
     // edges are left unsmoothed.
-    this.software = isSoftware(rendererName());
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !this.software });
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !isSoftware(rendererName()) });
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.renderer.setClearColor(BACKGROUND, 1);
     this.scene = new THREE.Scene();
