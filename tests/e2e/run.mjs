@@ -160,8 +160,15 @@ const host = (page, fn, arg) => page.evaluate(([h, src, a]) => {
 }, [HOST, fn.toString(), arg]);
 
 async function downloadText(page, button) {
-  const [d] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
-  return { name: d.suggestedFilename(), bytes: await readFile(await d.path()) };
+  try {
+    const [d] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
+    return { name: d.suggestedFilename(), bytes: await readFile(await d.path()) };
+  } catch (e) {
+    // Which button, and what the page said about it (a disabled one's title says why).
+    const said = await page.locator(button).evaluate((b) => `disabled ${b.disabled}, title “${b.title}”`, null, { timeout: 2000 }).catch(() => 'not found');
+    const status = await page.locator(`${HOST} >> #status`).textContent({ timeout: 2000 }).catch(() => '?');
+    throw new Error(`no download from ${button} (${said}; status “${status}”): ${e.message}`);
+  }
 }
 
 /** Loads a sample through the picker and waits until it is drawn. */
