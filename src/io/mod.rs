@@ -97,16 +97,18 @@ pub fn load_with(bytes: &[u8], name: &str, setup: &ImportSetup) -> Result<Model>
             let text = String::from_utf8_lossy(bytes);
             // The unit set for the file wins; else the one its header comment names (Maya's
             // export, OpenSubdiv's shapes); else mm.
-            let (units, setup) = match (setup.model_units, obj::unit_comment(&text)) {
-                (Some(u), _) => (u.name().to_string(), *setup),
-                (None, Some(u)) => (
-                    format!("{} (the file's header comment)", u.name()),
-                    ImportSetup {
-                        model_units: Some(u),
-                        ..*setup
-                    },
-                ),
-                (None, None) => ("mm (assumed)".to_string(), *setup),
+            let (units, setup) = match setup.model_units {
+                Some(u) => (u.name().to_string(), *setup),
+                None => match obj::unit_comment(&text) {
+                    Some(u) => (
+                        format!("{} (the file's header comment)", u.name()),
+                        ImportSetup {
+                            model_units: Some(u),
+                            ..*setup
+                        },
+                    ),
+                    None => ("mm (assumed)".to_string(), *setup),
+                },
             };
             let (mesh, warnings) = obj::read(&text)?;
             let mut m = Model::try_new_placed(name, "obj", &units, mesh, &setup, None)?;
