@@ -55,6 +55,11 @@ pub trait ParamSurface {
     fn subs(&self, u: f64, v: f64) -> Point3;
     /// Unit normal on the tool's side, taken from nearby where the surface is singular.
     fn normal(&self, u: f64, v: f64) -> Option<Vector3>;
+    /// [`ParamSurface::subs`] and [`ParamSurface::normal`] together (one evaluation where
+    /// the surface can).
+    fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
+        (self.subs(u, v), self.normal(u, v))
+    }
     /// Where this is, for error messages.
     fn label(&self) -> String;
     /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other.
@@ -89,14 +94,6 @@ pub fn patch_views(model: &Model) -> Vec<PatchView<'_>> {
         .collect()
 }
 
-impl PatchView<'_> {
-    /// Point and tool-side unit normal at `(u, v)`, from one evaluation.
-    pub fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
-        let (p, n) = self.patch.point_normal(self.surface, u, v);
-        (p, n.map(|n| n * self.side))
-    }
-}
-
 impl ParamSurface for PatchView<'_> {
     fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
         self.patch.derivs(self.surface, u, v)
@@ -106,6 +103,11 @@ impl ParamSurface for PatchView<'_> {
     }
     fn normal(&self, u: f64, v: f64) -> Option<Vector3> {
         self.patch.normal(self.surface, u, v).map(|n| n * self.side)
+    }
+    /// Point and tool-side unit normal at `(u, v)`, from one evaluation.
+    fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
+        let (p, n) = self.patch.point_normal(self.surface, u, v);
+        (p, n.map(|n| n * self.side))
     }
     fn side(&self) -> f64 {
         self.side
@@ -367,55 +369,119 @@ const SWEEP_PARALLEL: f64 = 1e-12;
 /// Parameter step of the finite difference giving a pass's direction.
 const TANGENT_STEP: f64 = 1e-5;
 
-/// Bisection steps locating the cusp between two passes (to 2⁻¹² of their gap).
-const CUSP_BISECTIONS: usize = 12;
+/// Most steps locating the cusp between two passes; a bisection would bracket it to 2⁻¹²
+/// of their gap in as many.
+const CUSP_STEPS: usize = 12;
+/// Share of the scallop height within which the cusp between two passes is located: the
+/// step stops where the material the two balls leave differs by less (dimensionless).
+const CUSP_LOCATE_SHARE: f64 = 1e-3;
 /// Relative excess of a cusp over its target tolerated before its gap is split: eq. 5 spaces
 /// passes for the target itself, so its cusps reach it to rounding; kinks exceed it by far.
 const CUSP_SLACK: f64 = 0.02;
 /// Times a gap between passes is split in three before its cusp is left as it is.
 const CUSP_SPLITS: usize = 4;
 
-/// The highest cusp between the passes at `w0` and `w1` (mm): at samples of the passes, the
-/// material left at the point between them where the two passes' swept balls (centred a
-/// radius along the surface normal from the contact points, swept along the ball-centre
-/// curve's tangent) leave equal material, found by bisection along the iso-line across.
-fn cusp_between(s: &dyn ParamSurface, dir: FeedDir, w0: f64, w1: f64, r: f64) -> Result<f64> {
-    let mut worst: f64 = 0.0;
-    for t in pass_samples() {
-        let sweep = |w: f64| -> Result<(Point3, Vector3)> {
+/// A pass near one of its samples, as [`cusp_between`] sees it.
+#[derive(Clone, Copy)]
+struct Sweep {
+    /// Contact point and unit normal.
+    cc: (Point3, Vector3),
+    /// Ball centre, and the ball-centre curve's unit tangent (zero where it has none).
+    cl: Point3,
+    tangent: Vector3,
+}
+
+/// The pass at `w` at each of [`pass_samples`].
+fn sweeps(s: &dyn ParamSurface, dir: FeedDir, w: f64, r: f64) -> Result<Vec<Sweep>> {
+    pass_samples()
+        .map(|t| {
             let cl = |t: f64| -> Result<Point3> {
                 let (p, n) = pass_point(s, dir, t, w)?;
                 Ok(p + n * r)
             };
             let (ta, tb) = ((t - TANGENT_STEP).max(0.0), (t + TANGENT_STEP).min(1.0));
-            let e = (cl(tb)? - cl(ta)?)
+            let tangent = (cl(tb)? - cl(ta)?)
                 .try_normalize(0.0)
                 .unwrap_or_else(Vector3::zeros);
-            Ok((cl(t)?, e))
+            let cc = pass_point(s, dir, t, w)?;
+            Ok(Sweep {
+                cc,
+                cl: cc.0 + cc.1 * r,
+                tangent,
+            })
+        })
+        .collect()
+}
+
+/// The highest cusp between the passes at `w0` and `w1` (mm), whose [`sweeps`] are `s0` and
+/// `s1`: at samples of the passes, the material left at the point between them where the two
+/// passes' swept balls (centred a radius along the surface normal from the contact points,
+/// swept along the ball-centre curve's tangent) leave equal material, found along the
+/// iso-line across by false position (Illinois) until the two differ by less than `tol`
+/// (mm), with a bisection step where a ball misses the normal line.
+fn cusp_between(
+    s: &dyn ParamSurface,
+    dir: FeedDir,
+    (w0, s0): (f64, &[Sweep]),
+    (w1, s1): (f64, &[Sweep]),
+    r: f64,
+    tol: f64,
+) -> Result<f64> {
+    let mut worst: f64 = 0.0;
+    for ((t, p0), p1) in pass_samples().zip(s0).zip(s1) {
+        // Material left by each pass at a point with normal n.
+        let left_at = |(q, n): (Point3, Vector3)| -> (f64, f64) {
+            (
+                left_by_swept_ball(&q, &n, (&p0.cl, &p0.tangent), r),
+                left_by_swept_ball(&q, &n, (&p1.cl, &p1.tangent), r),
+            )
         };
-        let (s0, s1) = (sweep(w0)?, sweep(w1)?);
-        // Material left by each pass at fraction x of the way across.
         let left = |x: f64| -> Result<(f64, f64)> {
-            let (q, n) = pass_point(s, dir, t, w0 + x * (w1 - w0))?;
-            Ok((
-                left_by_swept_ball(&q, &n, (&s0.0, &s0.1), r),
-                left_by_swept_ball(&q, &n, (&s1.0, &s1.1), r),
-            ))
+            Ok(left_at(pass_point(s, dir, t, w0 + x * (w1 - w0))?))
         };
+        // g = a − b rises across the gap: the first pass leaves least on its own line.
+        let g = |(a, b): (f64, f64)| a - b;
         let (mut lo, mut hi) = (0.0, 1.0);
+        let (mut g_lo, mut g_hi) = (g(left_at(p0.cc)), g(left_at(p1.cc)));
         let mut best = f64::INFINITY;
-        for _ in 0..CUSP_BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            let (a, b) = left(mid)?;
-            best = best.min(a.max(b));
-            if a < b {
-                lo = mid;
+        // Which end moved last (Illinois: the other end's value is halved when one end
+        // moves twice running).
+        let mut last_side = 0i8;
+        for _ in 0..CUSP_STEPS {
+            let x = if g_lo.is_finite() && g_hi.is_finite() && g_lo < 0.0 && g_hi > 0.0 {
+                let x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+                if x > lo && x < hi {
+                    x
+                } else {
+                    0.5 * (lo + hi)
+                }
             } else {
-                hi = mid;
+                0.5 * (lo + hi)
+            };
+            let (a, b) = left(x)?;
+            best = best.min(a.max(b));
+            let gx = g((a, b));
+            if gx.abs() <= tol {
+                break;
+            }
+            if a < b {
+                lo = x;
+                g_lo = gx;
+                if last_side == -1 {
+                    g_hi *= 0.5;
+                }
+                last_side = -1;
+            } else {
+                hi = x;
+                g_hi = gx;
+                if last_side == 1 {
+                    g_lo *= 0.5;
+                }
+                last_side = 1;
             }
         }
         // The cusp lies between the lesser of the two at the bracket's ends and the least
-        // of the greater over the bisection: take the upper end, unless a ball was missed.
+        // of the greater over the search: take the upper end, unless a ball was missed.
         let cusp = if best.is_finite() {
             best
         } else {
@@ -443,11 +509,21 @@ fn cusp_checked(
 ) -> Result<(Vec<f64>, f64)> {
     let mut out = vec![ws[0]];
     let mut worst: f64 = 0.0;
+    let tol = CUSP_LOCATE_SHARE * h;
+    // The gaps come in order across the patch: each one's first pass is the last one's second.
+    let mut last: (f64, Vec<Sweep>) = (ws[0], sweeps(s, dir, ws[0], r)?);
     for pair in ws.windows(2) {
         // Gaps still to check, last first, with how often each was split.
         let mut todo = vec![(pair[0], pair[1], 0usize)];
         while let Some((a, b, depth)) = todo.pop() {
-            let c = cusp_between(s, dir, a, b, r)?;
+            let first = if last.0 == a {
+                std::mem::take(&mut last.1)
+            } else {
+                sweeps(s, dir, a, r)?
+            };
+            let second = sweeps(s, dir, b, r)?;
+            let c = cusp_between(s, dir, (a, &first), (b, &second), r, tol)?;
+            last = (b, second);
             if c > h * (1.0 + CUSP_SLACK) && depth < CUSP_SPLITS {
                 let d = (b - a) / 3.0;
                 todo.extend([
@@ -467,11 +543,12 @@ fn cusp_checked(
 /// Contact point and unit normal on a pass.
 fn pass_point(s: &dyn ParamSurface, dir: FeedDir, t: f64, w: f64) -> Result<(Point3, Vector3)> {
     let (u, v) = at(dir, t, w);
-    let n = s.normal(u, v).ok_or_else(|| Error::Degenerate {
+    let (p, n) = s.point_normal(u, v);
+    let n = n.ok_or_else(|| Error::Degenerate {
         location: format!("{} at (u, v) = ({u:.6}, {v:.6})", s.label()),
         message: "the surface has no tangent plane here or nearby".into(),
     })?;
-    Ok((s.subs(u, v), n))
+    Ok((p, n))
 }
 
 /// How far a straight move may stray from the curve it replaces (mm).
@@ -485,18 +562,28 @@ pub struct ChordLimits {
     pub leave: f64,
 }
 
-/// Moving-parameter values along the pass at `w` so that chords stay within `lim`.
+/// Moving-parameter values along the pass at `w` so that chords stay within `lim`, each
+/// with its contact point and unit normal.
 pub fn forward_steps(
     s: &dyn ParamSurface,
     dir: FeedDir,
     w: f64,
     lim: ChordLimits,
     r: f64,
-) -> Result<Vec<f64>> {
+) -> Result<Vec<(f64, Point3, Vector3)>> {
     let (tol, dip, leave) = (lim.contact, lim.overcut, lim.leave);
-    let mut ts = vec![0.0];
     let mut t = 0.0;
     let mut p0 = pass_point(s, dir, 0.0, w)?;
+    let mut out = vec![(0.0, p0.0, p0.1)];
+    // Points of the last try by parameter: halving a step makes its middle the next try's
+    // end and its quarter the next try's middle.
+    let mut tried: Vec<(f64, (Point3, Vector3))> = Vec::with_capacity(4);
+    let point = |x: f64, tried: &[(f64, (Point3, Vector3))]| -> Result<(Point3, Vector3)> {
+        match tried.iter().find(|(y, _)| *y == x) {
+            Some(&(_, p)) => Ok(p),
+            None => pass_point(s, dir, x, w),
+        }
+    };
     while t < 1.0 {
         let (u, v) = at(dir, t, w);
         let d = s.derivs(u, v);
@@ -519,8 +606,11 @@ pub fn forward_steps(
         };
         let mut dt = first.min(1.0 - t).min(0.125);
         let mut accepted = None;
+        tried.clear();
         for _ in 0..MAX_HALVINGS {
-            let p1 = pass_point(s, dir, t + dt, w)?;
+            let mut now: Vec<(f64, (Point3, Vector3))> = Vec::with_capacity(4);
+            let p1 = point(t + dt, &tried)?;
+            now.push((t + dt, p1));
             let cl = |p: &(Point3, Vector3)| p.0 + p.1 * r;
             let (a, b) = (cl(&p0), cl(&p1));
             let ab = b - a;
@@ -528,7 +618,8 @@ pub fn forward_steps(
             // (where the curvature varies the largest gap is off the middle).
             let mut ok = true;
             for f in CHORD_PROBES {
-                let pm = pass_point(s, dir, t + f * dt, w)?;
+                let pm = point(t + f * dt, &tried)?;
+                now.push((t + f * dt, pm));
                 let m = cl(&pm);
                 let along = if ab.norm_squared() > 0.0 {
                     ((m - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
@@ -547,6 +638,7 @@ pub fn forward_steps(
                 accepted = Some(p1);
                 break;
             }
+            tried = now;
             dt *= 0.5;
         }
         let Some(p1) = accepted else {
@@ -555,11 +647,17 @@ pub fn forward_steps(
                 message: "the chordal tolerance cannot be met (a crease or cusp?)".into(),
             });
         };
-        t = if 1.0 - (t + dt) < 1e-12 { 1.0 } else { t + dt };
-        ts.push(t);
-        p0 = p1;
+        if 1.0 - (t + dt) < 1e-12 {
+            // The pass ends exactly at its side.
+            t = 1.0;
+            p0 = pass_point(s, dir, 1.0, w)?;
+        } else {
+            t += dt;
+            p0 = p1;
+        }
+        out.push((t, p0.0, p0.1));
     }
-    Ok(ts)
+    Ok(out)
 }
 
 /// Identity of each patch corner: corners at the same point share an id.
@@ -810,14 +908,14 @@ pub fn draft_with(
                 overcut: CHORD_MARGIN * opts.overcut_mm(),
                 leave,
             };
-            let mut ts = forward_steps(view, dir, w, limits, r)?;
+            let mut steps = forward_steps(view, dir, w, limits, r)?;
             let reversed = (li % 2 == 1) != (t_start == 1);
             if reversed {
-                ts = ts.iter().rev().copied().collect();
+                steps.reverse();
             }
+            let ts: Vec<f64> = steps.iter().map(|s| s.0).collect();
             let (w0, w1) = strip(li);
-            for (j, &t) in ts.iter().enumerate() {
-                let (cc, n) = pass_point(view, dir, t, w)?;
+            for (j, &(t, cc, n)) in steps.iter().enumerate() {
                 let (pu, pv) = at(dir, t, w);
                 let p = SurfacePoint {
                     patch,
