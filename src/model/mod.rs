@@ -39,6 +39,8 @@ pub struct Model {
     concave: std::sync::OnceLock<Option<ConcaveSpot>>,
     /// The side the tool works from, found once when first asked for.
     side: std::sync::OnceLock<f64>,
+    /// The distance sets planning built ([`Model::surface_distance`]).
+    pub(crate) distance_sets: crate::plan::distance::DistanceSets,
 }
 
 /// Where the surface is most tightly concave towards the tool (on the side
@@ -108,6 +110,7 @@ impl Model {
             surface,
             concave: std::sync::OnceLock::new(),
             side: std::sync::OnceLock::new(),
+            distance_sets: Default::default(),
         })
     }
 
@@ -168,6 +171,8 @@ impl Model {
             layout,
             concave: self.concave.clone(),
             side: self.side.clone(),
+            // Tessellations follow the layout's patches: none are shared.
+            distance_sets: Default::default(),
         }
     }
 

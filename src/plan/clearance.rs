@@ -10,6 +10,7 @@ use super::distance::SurfaceDistance;
 use super::PlanOptions;
 use crate::geom::{Point3, Vector3};
 use crate::model::Model;
+use std::sync::Arc;
 
 /// Chordal tolerance of the tessellation tested against a cylinder, in its radii: the
 /// cylinder grows by about this much, so a thin shank is tested against fine triangles and
@@ -26,11 +27,11 @@ const OWN_HOLDER_SET: f64 = 2.0;
 
 /// The model as seen by the shank and by the holder.
 pub struct Clearance {
-    shank: SurfaceDistance,
+    shank: Arc<SurfaceDistance>,
     /// The chordal tolerance the shank's tessellation was asked for (mm).
     shank_chordal_mm: f64,
     /// `None`: the holder is tested against the shank's triangles.
-    holder: Option<SurfaceDistance>,
+    holder: Option<Arc<SurfaceDistance>>,
 }
 
 impl Clearance {
@@ -44,8 +45,8 @@ impl Clearance {
         };
         let fine = chordal(opts.shank_radius());
         let coarse = chordal(opts.holder_radius_mm).max(fine);
-        let shank = SurfaceDistance::new(model, fine);
-        let holder = (coarse > OWN_HOLDER_SET * fine).then(|| SurfaceDistance::new(model, coarse));
+        let shank = model.surface_distance(fine);
+        let holder = (coarse > OWN_HOLDER_SET * fine).then(|| model.surface_distance(coarse));
         Clearance {
             shank,
             shank_chordal_mm: fine,

@@ -8,6 +8,7 @@
 
 use crate::geom::{Point3, Vector3};
 use crate::model::Model;
+use std::sync::{Arc, Mutex};
 
 /// Triangles per leaf of the hierarchy.
 const LEAF: usize = 8;
@@ -32,6 +33,55 @@ pub struct SurfaceDistance {
 
 /// Margin on the measured deviation (the triangles are measured at a few points each).
 const MEASURE_MARGIN: f64 = 1.25;
+
+/// Distance sets a model keeps after a plan: a plan asks for up to three (shank, holder,
+/// air moves), and the next plan of the same model (a slider moved on the page) asks for
+/// the same ones unless the tool changed.
+const KEPT_SETS: usize = 3;
+
+/// The distance sets a [`Model`] has built, by the chordal tolerance asked for, newest
+/// last; built once and then only read. A copy of the model starts with none.
+#[derive(Default)]
+pub struct DistanceSets(Mutex<Vec<(u64, Arc<SurfaceDistance>)>>);
+
+impl Clone for DistanceSets {
+    fn clone(&self) -> Self {
+        DistanceSets::default()
+    }
+}
+
+impl std::fmt::Debug for DistanceSets {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let n = self.0.lock().map(|v| v.len()).unwrap_or(0);
+        write!(f, "DistanceSets({n} kept)")
+    }
+}
+
+impl Model {
+    /// The model's [`SurfaceDistance`] for `chordal_mm`: the one built for an earlier plan
+    /// at the same tolerance, else a new one (kept for the plans after).
+    pub fn surface_distance(&self, chordal_mm: f64) -> Arc<SurfaceDistance> {
+        let key = chordal_mm.to_bits();
+        let kept = |sets: &DistanceSets| {
+            sets.0
+                .lock()
+                .ok()
+                .and_then(|v| v.iter().find(|(k, _)| *k == key).map(|(_, d)| d.clone()))
+        };
+        if let Some(d) = kept(&self.distance_sets) {
+            return d;
+        }
+        let d = Arc::new(SurfaceDistance::new(self, chordal_mm));
+        if let Ok(mut v) = self.distance_sets.0.lock() {
+            v.retain(|(k, _)| *k != key);
+            v.push((key, d.clone()));
+            if v.len() > KEPT_SETS {
+                v.remove(0);
+            }
+        }
+        d
+    }
+}
 
 impl SurfaceDistance {
     /// Tessellates `model` within about `tolerance_mm` and builds the hierarchy. The
@@ -811,5 +861,43 @@ mod tests {
             agree += brute as usize;
         }
         assert!(agree > 40 && agree < 360, "{agree} of 400 cylinders hit");
+    }
+
+    #[test]
+    fn a_model_keeps_its_distance_sets_for_the_next_plan_and_a_copy_starts_without() {
+        let m = crate::model::samples::load_sample("keycap-convex").unwrap();
+        let opts = crate::plan::PlanOptions {
+            tool_radius_mm: 0.5,
+            scallop_mm: 0.01,
+            ..Default::default()
+        };
+        let first = crate::plan::plan(&m, &opts, &mut |_| true).unwrap();
+        let kept = m.distance_sets.0.lock().unwrap().len();
+        assert!((1..=KEPT_SETS).contains(&kept), "{kept} sets kept");
+        // The second plan finds them, and plans the same path.
+        let again = crate::plan::plan(&m, &opts, &mut |_| true).unwrap();
+        assert_eq!(m.distance_sets.0.lock().unwrap().len(), kept);
+        assert_eq!(first.toolpath, again.toolpath);
+        let a = m.surface_distance(0.02);
+        assert!(Arc::ptr_eq(&a, &m.surface_distance(0.02)));
+        // A copy starts with none and builds its own, equal to the first.
+        let copy = m.clone();
+        assert_eq!(copy.distance_sets.0.lock().unwrap().len(), 0);
+        let b = copy.surface_distance(0.02);
+        assert!(!Arc::ptr_eq(&a, &b));
+        assert_eq!(
+            (a.tris.len(), a.tolerance_mm),
+            (b.tris.len(), b.tolerance_mm)
+        );
+        // Only the newest few are kept.
+        for k in 0..2 * KEPT_SETS {
+            m.surface_distance(0.03 + 0.001 * k as f64);
+        }
+        let sets = m.distance_sets.0.lock().unwrap();
+        assert_eq!(sets.len(), KEPT_SETS);
+        assert_eq!(
+            sets[KEPT_SETS - 1].0,
+            (0.03 + 0.001 * (2 * KEPT_SETS - 1) as f64).to_bits()
+        );
     }
 }

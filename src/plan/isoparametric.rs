@@ -155,22 +155,6 @@ fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> 
     best
 }
 
-/// Largest scallop predicted by eq. 5 between passes `w` and `w + dw`, sampled on both
-/// and half-way.
-fn predicted_between(s: &dyn ParamSurface, dir: FeedDir, w: f64, dw: f64, r: f64) -> f64 {
-    let mut worst: f64 = 0.0;
-    for &ww in &[w, w + 0.5 * dw, w + dw] {
-        for t in pass_samples() {
-            let (u, v) = at(dir, t, ww.min(1.0));
-            let Some(dg) = geom_at(s, u, v) else { continue };
-            let kappa = stepover::cross_curvature(&dg, dir);
-            let g = stepover::physical_side_step(&dg, dir, dw);
-            worst = worst.max(stepover::predicted_scallop(g, r, kappa));
-        }
-    }
-    worst
-}
-
 /// Grid intervals of a step profile across a patch.
 const PROFILE_INTERVALS: usize = 256;
 /// Ratio of the required steps at two neighbouring profile points above which the interval
@@ -259,14 +243,39 @@ fn refine_profile(
 /// Smallest parametric side step taken (a guard against runaway pass counts).
 const MIN_PARAM_STEP: f64 = 1e-9;
 
-/// Largest scallop predicted by eq. 5 over all adjacent passes.
+/// Largest scallop predicted by eq. 5 over all adjacent passes, sampled on both passes of
+/// each gap and half-way (each pass's samples serve both gaps it borders).
 pub(crate) fn predicted(s: &dyn ParamSurface, dir: FeedDir, ws: &[f64], r: f64) -> f64 {
     let mut sorted = ws.to_vec();
     sorted.sort_by(f64::total_cmp);
-    sorted
-        .windows(2)
-        .map(|w| predicted_between(s, dir, w[0], w[1] - w[0], r))
-        .fold(0.0, f64::max)
+    let row = |w: f64| -> Vec<Option<DiffGeom>> {
+        pass_samples()
+            .map(|t| {
+                let (u, v) = at(dir, t, w.min(1.0));
+                geom_at(s, u, v)
+            })
+            .collect()
+    };
+    let worst_on = |row: &[Option<DiffGeom>], dw: f64| -> f64 {
+        row.iter().flatten().fold(0.0, |worst: f64, dg| {
+            let kappa = stepover::cross_curvature(dg, dir);
+            let g = stepover::physical_side_step(dg, dir, dw);
+            worst.max(stepover::predicted_scallop(g, r, kappa))
+        })
+    };
+    let mut worst: f64 = 0.0;
+    let mut first = sorted.first().map(|&w| row(w));
+    for pair in sorted.windows(2) {
+        let dw = pair[1] - pair[0];
+        let second = row(pair[1]);
+        let on_first = first.as_deref().map_or(0.0, |g| worst_on(g, dw));
+        worst = worst
+            .max(on_first)
+            .max(worst_on(&row(pair[0] + 0.5 * dw), dw))
+            .max(worst_on(&second, dw));
+        first = Some(second);
+    }
+    worst
 }
 
 /// The across-parameter values of all passes for scallop `h`, and the largest predicted

@@ -15,7 +15,6 @@
 use super::air::{self, AirStats, Routed};
 use super::axis::{self, AxisStats};
 use super::clearance::Clearance;
-use super::distance::SurfaceDistance;
 use super::draft::{Draft, Footprint};
 use super::gouge::{self, GougeStats};
 use super::reach::{self, Rest, Why};
@@ -168,7 +167,7 @@ pub fn finish(
     let dist = match obs.shank_set_within(air_chordal, AIR_SHARED_SET) {
         Some(d) => d,
         None => {
-            own_air_set = SurfaceDistance::new(model, air_chordal);
+            own_air_set = model.surface_distance(air_chordal);
             &own_air_set
         }
     };
