@@ -20,6 +20,7 @@ use crate::error::{Error, Result};
 use crate::geom::{dist_to_segment, Point3, Vector3};
 use crate::layout::{ConnectionKind, Patch};
 use crate::model::Model;
+use crate::surface::diffgeom::unit_normal;
 use crate::surface::{DiffGeom, Surface, SurfaceDerivs};
 
 /// Samples along a pass used to find the side step to the next pass.
@@ -59,6 +60,10 @@ pub trait ParamSurface {
     /// the surface can).
     fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
         (self.subs(u, v), self.normal(u, v))
+    }
+    /// [`ParamSurface::derivs`] and [`ParamSurface::normal`] together.
+    fn derivs_normal(&self, u: f64, v: f64) -> (SurfaceDerivs, Option<Vector3>) {
+        (self.derivs(u, v), self.normal(u, v))
     }
     /// Where this is, for error messages.
     fn label(&self) -> String;
@@ -108,6 +113,11 @@ impl ParamSurface for PatchView<'_> {
     fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
         let (p, n) = self.patch.point_normal(self.surface, u, v);
         (p, n.map(|n| n * self.side))
+    }
+    /// Derivatives and tool-side unit normal at `(u, v)`, from one evaluation.
+    fn derivs_normal(&self, u: f64, v: f64) -> (SurfaceDerivs, Option<Vector3>) {
+        let (d, n) = self.patch.derivs_normal(self.surface, u, v);
+        (d, n.map(|n| n * self.side))
     }
     fn side(&self) -> f64 {
         self.side
@@ -400,23 +410,42 @@ struct Sweep {
     tangent: Vector3,
 }
 
-/// The pass at `w` at each of [`pass_samples`].
+/// The pass at `w` at each of [`pass_samples`]: the ball-centre curve's tangent
+/// `S_t + r n_t` from the derivatives where the surface has a normal (`n_t` the derivative
+/// of `S_u × S_v / |S_u × S_v|`), else by a finite difference.
 fn sweeps(s: &dyn ParamSurface, dir: FeedDir, w: f64, r: f64) -> Result<Vec<Sweep>> {
     pass_samples()
         .map(|t| {
-            let cl = |t: f64| -> Result<Point3> {
-                let (p, n) = pass_point(s, dir, t, w)?;
-                Ok(p + n * r)
+            let (u, v) = at(dir, t, w);
+            let (d, n) = s.derivs_normal(u, v);
+            let cc = match n {
+                Some(n) => (d.point, n),
+                // No normal here or nearby: pass_point says so.
+                None => pass_point(s, dir, t, w)?,
             };
-            let (ta, tb) = ((t - TANGENT_STEP).max(0.0), (t + TANGENT_STEP).min(1.0));
-            let tangent = (cl(tb)? - cl(ta)?)
-                .try_normalize(0.0)
-                .unwrap_or_else(Vector3::zeros);
-            let cc = pass_point(s, dir, t, w)?;
+            let (st, mt) = match dir {
+                FeedDir::AlongU => (d.su, d.suu.cross(&d.sv) + d.su.cross(&d.suv)),
+                FeedDir::AlongV => (d.sv, d.suv.cross(&d.sv) + d.su.cross(&d.svv)),
+            };
+            let tangent = match unit_normal(&d.su, &d.sv) {
+                Some(m) => {
+                    let len = d.su.cross(&d.sv).norm();
+                    let nt = (mt - m * m.dot(&mt)) * (s.side() / len);
+                    (st + nt * r).try_normalize(0.0)
+                }
+                None => {
+                    let cl = |t: f64| -> Result<Point3> {
+                        let (p, n) = pass_point(s, dir, t, w)?;
+                        Ok(p + n * r)
+                    };
+                    let (ta, tb) = ((t - TANGENT_STEP).max(0.0), (t + TANGENT_STEP).min(1.0));
+                    (cl(tb)? - cl(ta)?).try_normalize(0.0)
+                }
+            };
             Ok(Sweep {
                 cc,
                 cl: cc.0 + cc.1 * r,
-                tangent,
+                tangent: tangent.unwrap_or_else(Vector3::zeros),
             })
         })
         .collect()
@@ -1052,4 +1081,47 @@ pub fn plan_zigzag(
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Toolpath> {
     plan(model, opts, progress).map(|p| p.toolpath)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ball-centre curve's tangent from the derivatives against a central difference of
+    /// ball centres (the second method), along both parameters, on samples machined from
+    /// either side.
+    #[test]
+    fn sweep_tangents_match_finite_differences_of_the_ball_centre_curve() {
+        let r = 0.7;
+        let mut checked = 0;
+        for name in ["keycap-convex", "keycap-concave", "bumps", "tjunction"] {
+            let model = crate::model::samples::load_sample(name).unwrap();
+            for view in patch_views(&model) {
+                for dir in [FeedDir::AlongU, FeedDir::AlongV] {
+                    for w in [0.13, 0.5, 0.91] {
+                        let got = sweeps(&view, dir, w, r).unwrap();
+                        for (t, sweep) in pass_samples().zip(&got) {
+                            if !(0.01..=0.99).contains(&t) {
+                                continue;
+                            }
+                            let cl = |t: f64| {
+                                let (p, n) = pass_point(&view, dir, t, w).unwrap();
+                                p + n * r
+                            };
+                            let h = 1e-6;
+                            let fd = (cl(t + h) - cl(t - h)).normalize();
+                            let angle = sweep.tangent.angle(&fd);
+                            assert!(
+                                angle < 1e-4 || (std::f64::consts::PI - angle) < 1e-4,
+                                "{name} patch {} {dir:?} w {w} t {t}: {angle} rad",
+                                view.index
+                            );
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked} tangents");
+    }
 }
