@@ -40,7 +40,7 @@ const MEASURE_MARGIN: f64 = 1.25;
 const KEPT_SETS: usize = 3;
 
 /// The distance sets a [`Model`] has built, by the chordal tolerance asked for, newest
-/// last; built once and then only read. A copy of the model starts with none.
+/// last; each is built once and then only read. A copy of the model starts with none.
 #[derive(Default)]
 pub struct DistanceSets(Mutex<Vec<(u64, Arc<SurfaceDistance>)>>);
 
