@@ -62,13 +62,12 @@ impl Model {
     /// at the same tolerance, else a new one (kept for the plans after).
     pub fn surface_distance(&self, chordal_mm: f64) -> Arc<SurfaceDistance> {
         let key = chordal_mm.to_bits();
-        let kept = |sets: &DistanceSets| {
-            sets.0
-                .lock()
-                .ok()
-                .and_then(|v| v.iter().find(|(k, _)| *k == key).map(|(_, d)| d.clone()))
-        };
-        if let Some(d) = kept(&self.distance_sets) {
+        let kept = self.distance_sets.0.lock().ok().and_then(|v| {
+            v.iter()
+                .find(|(k, _)| *k == key)
+                .map(|(_, d)| Arc::clone(d))
+        });
+        if let Some(d) = kept {
             return d;
         }
         let d = Arc::new(SurfaceDistance::new(self, chordal_mm));

@@ -56,15 +56,10 @@ pub trait ParamSurface {
     fn subs(&self, u: f64, v: f64) -> Point3;
     /// Unit normal on the tool's side, taken from nearby where the surface is singular.
     fn normal(&self, u: f64, v: f64) -> Option<Vector3>;
-    /// [`ParamSurface::subs`] and [`ParamSurface::normal`] together (one evaluation where
-    /// the surface can).
-    fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
-        (self.subs(u, v), self.normal(u, v))
-    }
-    /// [`ParamSurface::derivs`] and [`ParamSurface::normal`] together.
-    fn derivs_normal(&self, u: f64, v: f64) -> (SurfaceDerivs, Option<Vector3>) {
-        (self.derivs(u, v), self.normal(u, v))
-    }
+    /// [`ParamSurface::subs`] and [`ParamSurface::normal`] from one evaluation.
+    fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>);
+    /// [`ParamSurface::derivs`] and [`ParamSurface::normal`] from one evaluation.
+    fn derivs_normal(&self, u: f64, v: f64) -> (SurfaceDerivs, Option<Vector3>);
     /// Where this is, for error messages.
     fn label(&self) -> String;
     /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other.
@@ -274,16 +269,18 @@ pub(crate) fn predicted(s: &dyn ParamSurface, dir: FeedDir, ws: &[f64], r: f64) 
         })
     };
     let mut worst: f64 = 0.0;
-    let mut first = sorted.first().map(|&w| row(w));
+    let Some(&w0) = sorted.first() else {
+        return worst;
+    };
+    let mut first = row(w0);
     for pair in sorted.windows(2) {
         let dw = pair[1] - pair[0];
         let second = row(pair[1]);
-        let on_first = first.as_deref().map_or(0.0, |g| worst_on(g, dw));
         worst = worst
-            .max(on_first)
+            .max(worst_on(&first, dw))
             .max(worst_on(&row(pair[0] + 0.5 * dw), dw))
             .max(worst_on(&second, dw));
-        first = Some(second);
+        first = second;
     }
     worst
 }
@@ -616,6 +613,7 @@ pub fn forward_steps(
     // Points of the last try by parameter: halving a step makes its middle the next try's
     // end and its quarter the next try's middle.
     let mut tried: Vec<(f64, (Point3, Vector3))> = Vec::with_capacity(4);
+    let mut now: Vec<(f64, (Point3, Vector3))> = Vec::with_capacity(4);
     let point = |x: f64, tried: &[(f64, (Point3, Vector3))]| -> Result<(Point3, Vector3)> {
         match tried.iter().find(|(y, _)| *y == x) {
             Some(&(_, p)) => Ok(p),
@@ -646,7 +644,7 @@ pub fn forward_steps(
         let mut accepted = None;
         tried.clear();
         for _ in 0..MAX_HALVINGS {
-            let mut now: Vec<(f64, (Point3, Vector3))> = Vec::with_capacity(4);
+            now.clear();
             let p1 = point(t + dt, &tried)?;
             now.push((t + dt, p1));
             let cl = |p: &(Point3, Vector3)| p.0 + p.1 * r;
@@ -676,7 +674,7 @@ pub fn forward_steps(
                 accepted = Some(p1);
                 break;
             }
-            tried = now;
+            std::mem::swap(&mut tried, &mut now);
             dt *= 0.5;
         }
         let Some(p1) = accepted else {
