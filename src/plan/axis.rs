@@ -81,11 +81,12 @@ pub(super) fn tilted(theta: f64, phi: f64) -> Vector3 {
 }
 
 /// The least tilt (radians) along azimuth `phi` at which the tool is clear, to within
-/// [`TILT_RESOLUTION_DEG`]. From a `hint` (the previous point's tilt: it changes little from
-/// point to point) the search gallops down while clear or up while not, from a step of twice
-/// the resolution doubling up to [`TILT_STEP_UNITS`], then bisects the last step; so a tilt
-/// close to the hint costs three or four tests. Without a hint it starts from the vertical
-/// in steps of [`TILT_STEP_UNITS`] up to the largest allowed.
+/// [`TILT_RESOLUTION_DEG`]. From a `hint` (the tilt expected from the points before: it
+/// changes smoothly from point to point) the search gallops down while clear or up while
+/// not, in steps of one resolution, one more, then doubling up to [`TILT_STEP_UNITS`], and
+/// bisects the last step; so the hinted tilt costs two tests, one a resolution either side
+/// two or three. Without a hint it starts from the vertical in steps of [`TILT_STEP_UNITS`]
+/// up to the largest allowed.
 pub(super) fn least_tilt(
     obs: &Clearance,
     (c, n): (&Point3, &Vector3),
@@ -101,31 +102,45 @@ pub(super) fn least_tilt(
     let top = (max / res).ceil() as i64;
     let tilt = |k: i64| (k as f64 * res).min(max);
     let clear = |k: i64| usable(obs, (c, n), &tilted(tilt(k), phi), opts);
+    let hint = hint.map(|h| ((h / res).round() as i64).clamp(1, top.max(1)));
+    least_clear_unit(top, hint, clear).map(tilt)
+}
+
+/// The search of [`least_tilt`] in whole resolutions: the least `k` in `1..=top` for which
+/// `clear(k)` holds (where clear tilts are all those from some least one up, which the
+/// search assumes; elsewhere a clear `k` whose neighbour below is blocked), from the hinted
+/// `k` or without one from 0 (`clear(0)` is never asked: the caller found the vertical
+/// blocked).
+fn least_clear_unit(
+    top: i64,
+    hint: Option<i64>,
+    mut clear: impl FnMut(i64) -> bool,
+) -> Option<i64> {
     // `hi` clear, `lo` not (or zero, where the vertical was found not clear).
-    let (mut lo, mut hi) = match hint.map(|h| ((h / res).round() as i64).clamp(1, top.max(1))) {
+    let (mut lo, mut hi) = match hint {
         Some(h) if clear(h) => {
-            let (mut hi, mut step) = (h, 2);
+            let (mut hi, mut steps) = (h, 0);
             loop {
-                let lo = (hi - step).max(0);
+                let lo = (hi - gallop_step(steps)).max(0);
                 if lo == 0 || !clear(lo) {
                     break (lo, hi);
                 }
                 hi = lo;
-                step = (2 * step).min(TILT_STEP_UNITS);
+                steps += 1;
             }
         }
         Some(h) => {
-            let (mut lo, mut step) = (h, 2);
+            let (mut lo, mut steps) = (h, 0);
             loop {
                 if lo >= top {
                     return None;
                 }
-                let hi = (lo + step).min(top);
+                let hi = (lo + gallop_step(steps)).min(top);
                 if clear(hi) {
                     break (lo, hi);
                 }
                 lo = hi;
-                step = (2 * step).min(TILT_STEP_UNITS);
+                steps += 1;
             }
         }
         None => {
@@ -151,21 +166,30 @@ pub(super) fn least_tilt(
             lo = mid;
         }
     }
-    Some(tilt(hi))
+    Some(hi)
+}
+
+/// The `k`-th step (counting from 0) of [`least_tilt`]'s gallop from a hint, in
+/// resolutions: 1, 1, 2, 4, … up to [`TILT_STEP_UNITS`].
+fn gallop_step(k: u32) -> i64 {
+    (1i64 << k.saturating_sub(1).min(6)).min(TILT_STEP_UNITS)
 }
 
 /// A clear axis at `c`, continuing the previous point's lean: the least clear tilt along
 /// its azimuth or the nearest clear one; else away from the sample the vertical tool hits;
-/// failing those, around the circle.
+/// failing those, around the circle. The searches start from the previous point's tilt
+/// plus `trend` (radians: how much the tilt changed from the point before it, 0 where
+/// unknown; the least clear tilt changes smoothly along a pass, so that is close).
 fn clear_axis(
     obs: &Clearance,
     (c, n): (&Point3, &Vector3),
     opts: &PlanOptions,
-    prev: &Vector3,
+    (prev, trend): (&Vector3, f64),
     hit: &Point3,
 ) -> Option<Vector3> {
     let away = (c.y - hit.y).atan2(c.x - hit.x);
-    let hint = (prev.z < 1.0 - VERTICAL_COS_SLACK).then(|| prev.z.clamp(-1.0, 1.0).acos());
+    let hint = (prev.z < 1.0 - VERTICAL_COS_SLACK)
+        .then(|| (prev.z.clamp(-1.0, 1.0).acos() + trend).max(0.0));
     // Keep turning the way the previous point did, at the least tilt clear that way, even
     // where another way needs less: the axis then does not swing round between
     // neighbouring points (on the head at h = 0.05 mm, switching to a way needing 5° less
@@ -354,7 +378,7 @@ pub(super) fn bridge(
     }
     let axis = match vertical_hit(obs, (&cl, &n), &cc, opts) {
         None => Some(Vector3::z()),
-        Some(h) => halfway().or_else(|| clear_axis(obs, (&cl, &n), opts, &a.tool_axis, &h)),
+        Some(h) => halfway().or_else(|| clear_axis(obs, (&cl, &n), opts, (&a.tool_axis, 0.0), &h)),
     };
     match axis {
         Some(axis) => halves(axis, out),
@@ -434,6 +458,9 @@ pub fn choose(
 ) -> Result<(AxisStats, Vec<Option<Why>>)> {
     let n = path.moves.len();
     let mut prev = Vector3::z();
+    // The move `prev` belongs to, and how much the tilt changed to it from the move before
+    // (radians; 0 unless both were cut points one after the other, both tilted).
+    let (mut prev_at, mut trend) = (None, 0.0);
     let mut stats = AxisStats::default();
     let mut why: Vec<Option<Why>> = vec![None; n];
     for i in 0..n {
@@ -490,7 +517,14 @@ pub fn choose(
         };
         if let Some(h) = blocked_at {
             match (opts.max_tilt_deg > 0.0)
-                .then(|| clear_axis(obs, (&c, &normal), opts, &prev, &h))
+                .then(|| {
+                    let trend = if prev_at == i.checked_sub(1) {
+                        trend
+                    } else {
+                        0.0
+                    };
+                    clear_axis(obs, (&c, &normal), opts, (&prev, trend), &h)
+                })
                 .flatten()
             {
                 Some(a) => {
@@ -516,7 +550,14 @@ pub fn choose(
         }
         path.moves[i].tool_axis = axis;
         if why[i].is_none() {
+            let tilted = |a: &Vector3| a.z < 1.0 - VERTICAL_COS_SLACK;
+            trend = if prev_at == i.checked_sub(1) && tilted(&prev) && tilted(&axis) {
+                axis.z.clamp(-1.0, 1.0).acos() - prev.z.clamp(-1.0, 1.0).acos()
+            } else {
+                0.0
+            };
             prev = axis;
+            prev_at = Some(i);
         }
         if i % 512 == 0 && !progress(i as f64 / n as f64) {
             return Err(Error::Cancelled);
@@ -547,6 +588,47 @@ pub fn fill_air_axes(path: &mut Toolpath) {
             if let Some(a) = next {
                 path.moves[i].tool_axis = a;
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tilt_search_finds_the_least_clear_tilt_from_any_hint_and_two_tests_from_the_right_one() {
+        // Clear from `least` up: every hint (none, the answer, near it, far from it, past
+        // the top) finds `least`; the hinted answer costs two tests, one either side at most
+        // three (the hint is the tilt extrapolated along the pass: mostly that close).
+        let top = 1500;
+        for least in [1, 2, 3, 17, 64, 65, 700, 1499, 1500] {
+            // Hints as the caller gives them: within 1..=top.
+            let hints = [None, Some(least), Some(least - 1), Some(least + 1)]
+                .into_iter()
+                .chain([-300, -40, -7, -2, 2, 7, 40, 300].map(|d| Some(least + d)))
+                .map(|h| h.map(|h| h.clamp(1, top)));
+            for hint in hints {
+                let mut tests = 0;
+                let found = least_clear_unit(top, hint, |k| {
+                    assert!((1..=top).contains(&k), "asked for {k}");
+                    tests += 1;
+                    k >= least
+                });
+                assert_eq!(found, Some(least), "hint {hint:?}");
+                let most = match hint.map(|h| h - least) {
+                    Some(0) => 2,
+                    Some(-1 | 1) if least > 1 && least < top => 3,
+                    // From the vertical in coarse steps, then bisecting one.
+                    None => top / TILT_STEP_UNITS + 7,
+                    _ => 24,
+                };
+                assert!(tests <= most, "least {least}, hint {hint:?}: {tests} tests");
+            }
+        }
+        // Nothing clear: none, from every hint.
+        for hint in [None, Some(1), Some(700), Some(top)] {
+            assert_eq!(least_clear_unit(top, hint, |_| false), None);
         }
     }
 }
