@@ -10,6 +10,7 @@ use super::distance::SurfaceDistance;
 use super::PlanOptions;
 use crate::geom::{Point3, Vector3};
 use crate::model::Model;
+use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 use std::sync::Arc;
 
 /// Chordal tolerance of the tessellation tested against a cylinder, in its radii: the
@@ -32,6 +33,10 @@ pub struct Clearance {
     shank_chordal_mm: f64,
     /// `None`: the holder is tested against the shank's triangles.
     holder: Option<Arc<SurfaceDistance>>,
+    /// Whether the holder was the one that met the model in the last blocked
+    /// [`Self::clear`]: it is tested first next time (a blocked test ends at the first
+    /// cylinder that meets the model, a clear one tests both).
+    holder_first: AtomicBool,
 }
 
 impl Clearance {
@@ -51,6 +56,7 @@ impl Clearance {
             shank,
             shank_chordal_mm: fine,
             holder,
+            holder_first: AtomicBool::new(false),
         }
     }
 
@@ -132,7 +138,29 @@ impl Clearance {
 
     /// True if the shank and holder at `c` along `axis` are clear of the model.
     pub fn clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
-        self.hit(c, axis, opts).is_none()
+        let (f, ls, lh) = (
+            opts.flute_length(),
+            opts.shank_length_mm,
+            opts.holder_length_mm,
+        );
+        let shank = || grown_hit(&self.shank, c, axis, (f, ls), opts.shank_radius()).is_some();
+        let holder =
+            || grown_hit(self.holder(), c, axis, (ls, ls + lh), opts.holder_radius_mm).is_some();
+        // Which of the two meets the model does not change the answer, only its cost.
+        let holder_first = self.holder_first.load(Relaxed);
+        let (first, second): (&dyn Fn() -> bool, &dyn Fn() -> bool) = if holder_first {
+            (&holder, &shank)
+        } else {
+            (&shank, &holder)
+        };
+        if first() {
+            return false;
+        }
+        if second() {
+            self.holder_first.store(!holder_first, Relaxed);
+            return false;
+        }
+        true
     }
 }
 
@@ -224,6 +252,50 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn clear_answers_as_the_hit_does_whichever_cylinder_it_tests_first() {
+        // Random poses of a fat shank and a holder over the concave keycap: some blocked
+        // by the shank only, some by the holder only (so the order of the tests swaps back
+        // and forth), and `clear` says what `hit` finds every time.
+        let m = crate::model::samples::load_sample("keycap-concave").unwrap();
+        let mut opts = PlanOptions::default()
+            .with_tool_radius(0.5)
+            .with_holder(1.0, 6.0, 6.0, 30.0);
+        opts.flute_length_mm = Some(1.0);
+        let obs = Clearance::new(&m, &opts);
+        let (f, ls, lh) = (1.0, 6.0, 30.0);
+        let only = |c: &Point3, a: &Vector3, holder: bool| {
+            let s = grown_hit(&obs.shank, c, a, (f, ls), 1.0).is_some();
+            let h = grown_hit(obs.holder(), c, a, (ls, ls + lh), 6.0).is_some();
+            if holder {
+                h && !s
+            } else {
+                s && !h
+            }
+        };
+        let bbox = m.surface.bbox();
+        let mut rnd = crate::testing::uniform(11u64);
+        let (mut by_shank, mut by_holder, mut swaps) = (0, 0, 0);
+        for _ in 0..2000 {
+            let c = Point3::new(
+                bbox.min[0] + (bbox.max[0] - bbox.min[0]) * rnd(),
+                bbox.min[1] + (bbox.max[1] - bbox.min[1]) * rnd(),
+                bbox.min[2] + (bbox.max[2] - bbox.min[2] + 8.0) * rnd(),
+            );
+            let a = crate::plan::axis::tilted(
+                (60.0 * rnd()).to_radians(),
+                std::f64::consts::TAU * rnd(),
+            );
+            let first = obs.holder_first.load(Relaxed);
+            assert_eq!(obs.clear(&c, &a, &opts), obs.hit(&c, &a, &opts).is_none());
+            swaps += usize::from(obs.holder_first.load(Relaxed) != first);
+            by_shank += usize::from(only(&c, &a, false));
+            by_holder += usize::from(only(&c, &a, true));
+        }
+        println!("{by_shank} by the shank only, {by_holder} by the holder only, {swaps} swaps");
+        assert!(by_shank > 10 && by_holder > 10 && swaps > 10);
     }
 
     #[test]
