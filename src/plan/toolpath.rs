@@ -299,60 +299,104 @@ impl PlanReport {
     }
 }
 
-/// A rebuilt path's vectors start with room for this fraction (one in so many) more moves
-/// than the old path.
-const REBUILD_ROOM: usize = 16;
-
 impl Toolpath {
     /// Rebuilds the moves: `f(old, i, add)` adds, through `add(move, params)`, the moves
     /// that replace old move `i` (`old` holds the old moves and their params, the latter
     /// empty where the path has none; at least one move each, the last standing for it).
     /// Keeps `runs` and `params` in step.
+    ///
+    /// In place: the old moves stay where they are while `f` reads them, only the moves
+    /// that differ from them are kept aside, and the path then grows by the moves added and
+    /// is rewritten from its end (the path is the plan's largest allocation: a second copy
+    /// of it doubled a five-axis plan's peak memory).
     pub fn rebuild(&mut self, mut f: impl FnMut(OldMoves, usize, &mut dyn FnMut(Move, [f64; 2]))) {
         let n = self.moves.len();
         let has_params = self.params.len() == n;
-        let old_moves = std::mem::take(&mut self.moves);
-        let old_params = if has_params {
-            std::mem::take(&mut self.params)
-        } else {
-            Vec::new()
-        };
-        let old = OldMoves {
-            moves: &old_moves,
-            params: &old_params,
-        };
-        // Room for a few added moves (the bridging adds some per cent at most): a vector
-        // grown past its capacity doubles, and the path is the plan's largest allocation.
-        let room = n + n / REBUILD_ROOM + 16;
-        let mut moves: Vec<Move> = Vec::with_capacity(room);
-        let mut params: Vec<[f64; 2]> = Vec::with_capacity(if has_params { room } else { 0 });
-        // First and last new index of each old move.
-        let mut new_index = vec![(0usize, 0usize); n];
-        for (i, slot) in new_index.iter_mut().enumerate() {
-            let first = moves.len();
-            f(old, i, &mut |m, q| {
-                moves.push(m);
-                if has_params {
-                    params.push(q);
+        // Old moves whose replacement is not the move itself: (index, where its moves start
+        // in `added`), and those moves.
+        let mut changed: Vec<(usize, usize)> = Vec::new();
+        let mut added: Vec<(Move, [f64; 2])> = Vec::new();
+        {
+            let old = OldMoves {
+                moves: &self.moves,
+                params: if has_params { &self.params } else { &[] },
+            };
+            for i in 0..n {
+                let first = added.len();
+                f(old, i, &mut |m, q| added.push((m, q)));
+                debug_assert!(added.len() > first, "move {i} was dropped");
+                let same = added.len() == first + 1
+                    && added[first].0 == old.moves[i]
+                    && (!has_params || added[first].1 == old.params[i]);
+                if same {
+                    added.truncate(first);
+                } else {
+                    changed.push((i, first));
                 }
-            });
-            debug_assert!(moves.len() > first, "move {i} was dropped");
-            *slot = (first, moves.len().max(first + 1) - 1);
-        }
-        if moves.len() != n {
-            for run in &mut self.runs {
-                run.first_move = new_index[run.first_move].0;
-                run.last_move = new_index[run.last_move].1;
             }
         }
-        drop(old_moves);
-        drop(old_params);
-        moves.shrink_to_fit();
-        params.shrink_to_fit();
-        self.moves = moves;
-        if has_params {
-            self.params = params;
+        if changed.is_empty() {
+            return;
         }
+        // Moves standing for old move `k` of `changed`.
+        let span = |k: usize| {
+            let end = changed.get(k + 1).map_or(added.len(), |c| c.1);
+            changed[k].1..end
+        };
+        let grown = n + added.len() - changed.len();
+        // First and last new index of each old move.
+        let new_index = |i: usize| {
+            // Moves added by the changed old moves before `i`, beyond one each.
+            let k = changed.partition_point(|c| c.0 < i);
+            let before = if k == 0 {
+                0
+            } else {
+                changed[k - 1].1 + span(k - 1).len() - k
+            };
+            let first = i + before;
+            let own = if changed.get(k).is_some_and(|c| c.0 == i) {
+                span(k).len()
+            } else {
+                1
+            };
+            (first, first + own - 1)
+        };
+        for run in &mut self.runs {
+            run.first_move = new_index(run.first_move).0;
+            run.last_move = new_index(run.last_move).1;
+        }
+        // Exactly (a vector that outgrows its room doubles it); the allocator can grow a
+        // block this large where it lies.
+        let filler = self.moves[0];
+        self.moves.reserve_exact(grown - n);
+        self.moves.resize(grown, filler);
+        if has_params {
+            self.params.reserve_exact(grown - n);
+            self.params.resize(grown, [0.0; 2]);
+        }
+        // From the end: each old move lands at or after where it was, so nothing is
+        // overwritten before it is moved.
+        let mut to = grown;
+        let mut k = changed.len();
+        for i in (0..n).rev() {
+            if k > 0 && changed[k - 1].0 == i {
+                k -= 1;
+                for j in span(k).rev() {
+                    to -= 1;
+                    self.moves[to] = added[j].0;
+                    if has_params {
+                        self.params[to] = added[j].1;
+                    }
+                }
+            } else {
+                to -= 1;
+                self.moves[to] = self.moves[i];
+                if has_params {
+                    self.params[to] = self.params[i];
+                }
+            }
+        }
+        debug_assert_eq!(to, 0);
     }
 
     /// A path of `moves` for a ball of radius `tool_radius_mm`, without planner details.
@@ -517,3 +561,106 @@ impl Toolpath {
 /// Two consecutive cutting directions (links between them ignored) with a cosine below this
 /// are a reversal: turning by more than 120°, as at the end of a zig-zag line.
 const REVERSAL_COS: f64 = -0.5;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What [`Toolpath::rebuild`] must give: new vectors built from the old ones, each old
+    /// move's first and last new index for the runs.
+    #[allow(clippy::type_complexity)]
+    fn rebuilt_by_copy(
+        path: &Toolpath,
+        f: &mut dyn FnMut(OldMoves, usize, &mut dyn FnMut(Move, [f64; 2])),
+    ) -> (Vec<Move>, Vec<[f64; 2]>, Vec<(usize, usize)>) {
+        let old = OldMoves {
+            moves: &path.moves,
+            params: &path.params,
+        };
+        let (mut moves, mut params, mut runs) = (Vec::new(), Vec::new(), Vec::new());
+        let mut index = Vec::new();
+        for i in 0..path.moves.len() {
+            let first = moves.len();
+            f(old, i, &mut |m, q| {
+                moves.push(m);
+                params.push(q);
+            });
+            index.push((first, moves.len() - 1));
+        }
+        for r in &path.runs {
+            runs.push((index[r.first_move].0, index[r.last_move].1));
+        }
+        (moves, params, runs)
+    }
+
+    #[test]
+    fn rebuilding_in_place_gives_what_building_a_copy_gives() {
+        // Paths of random length whose moves are kept, changed, or given up to three moves
+        // before them (some paths none changed, some all), runs over them: the same moves,
+        // params and runs as a rebuild into new vectors.
+        let mut rnd = crate::testing::uniform(5u64);
+        for trial in 0..60 {
+            let n = 1 + (rnd() * 300.0) as usize;
+            let mv = |k: usize| Move {
+                kind: MoveKind::Feed,
+                cc_point: Point3::new(k as f64, 0.0, 0.0),
+                cl_point: Point3::new(k as f64, 0.0, 1.0),
+                tool_axis: Vector3::z(),
+                patch: 0,
+                line: k as u32,
+            };
+            let mut path = Toolpath::new(1.0, (0..n).map(mv).collect());
+            path.params = (0..n).map(|k| [k as f64, 0.5]).collect();
+            let mut cut = 0;
+            while cut < n {
+                let last = (cut + (rnd() * 40.0) as usize).min(n - 1);
+                path.runs.push(PatchRun {
+                    patch: 0,
+                    start_corner: 0,
+                    finish_corner: 1,
+                    crossfeed: Crossfeed::U,
+                    passes: 1,
+                    scallop_used_mm: 0.01,
+                    retract_before: false,
+                    first_move: cut,
+                    last_move: last,
+                });
+                cut = last + 1;
+            }
+            let share = [0.0, 1.0, 0.1, 0.5][trial % 4];
+            let plan: Vec<(usize, bool)> = (0..n)
+                .map(|_| {
+                    let more = if rnd() < share {
+                        1 + (rnd() * 3.0) as usize
+                    } else {
+                        0
+                    };
+                    (more, rnd() < share)
+                })
+                .collect();
+            let mut f = |old: OldMoves, i: usize, add: &mut dyn FnMut(Move, [f64; 2])| {
+                let (more, change) = plan[i];
+                for j in 0..more {
+                    let mut m = old.moves[i];
+                    m.cl_point.y = 10.0 + j as f64;
+                    add(m, [old.param(i)[0] - 0.5, j as f64]);
+                }
+                let mut m = old.moves[i];
+                if change {
+                    m.cl_point.z += 1.0;
+                }
+                add(m, old.param(i));
+            };
+            let (moves, params, runs) = rebuilt_by_copy(&path, &mut f);
+            path.rebuild(&mut f);
+            assert_eq!(path.moves, moves, "trial {trial}");
+            assert_eq!(path.params, params, "trial {trial}");
+            let got: Vec<(usize, usize)> = path
+                .runs
+                .iter()
+                .map(|r| (r.first_move, r.last_move))
+                .collect();
+            assert_eq!(got, runs, "trial {trial}");
+        }
+    }
+}
