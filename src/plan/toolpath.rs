@@ -325,9 +325,13 @@ impl Toolpath {
                 let first = added.len();
                 f(old, i, &mut |m, q| added.push((m, q)));
                 debug_assert!(added.len() > first, "move {i} was dropped");
-                let same = added.len() == first + 1
-                    && added[first].0 == old.moves[i]
-                    && (!has_params || added[first].1 == old.params[i]);
+                // Where `f` added nothing (against its contract: the debug build stops
+                // there), the old move stays, so the path never shrinks (each old move
+                // lands at or after where it was, as the rewrite below needs).
+                let same = added.len() == first
+                    || added.len() == first + 1
+                        && added[first].0 == old.moves[i]
+                        && (!has_params || added[first].1 == old.params[i]);
                 if same {
                     added.truncate(first);
                 } else {
