@@ -80,13 +80,30 @@ impl Clearance {
     /// A point of the model inside the shank (above the flutes) or the holder of a tool
     /// with its ball centre at `c` along unit `axis`, if there is one.
     pub fn hit(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> Option<Point3> {
+        let [shank, holder] = self.cylinders(opts);
+        shank.hit(c, axis).or_else(|| holder.hit(c, axis))
+    }
+
+    /// The shank (above the flutes) and the holder of the tool of `opts`, each with the
+    /// triangles it is tested against.
+    fn cylinders(&self, opts: &PlanOptions) -> [ToolCylinder<'_>; 2] {
         let (f, ls, lh) = (
             opts.flute_length(),
             opts.shank_length_mm,
             opts.holder_length_mm,
         );
-        grown_hit(&self.shank, c, axis, (f, ls), opts.shank_radius())
-            .or_else(|| grown_hit(self.holder(), c, axis, (ls, ls + lh), opts.holder_radius_mm))
+        [
+            ToolCylinder {
+                set: &self.shank,
+                span: (f, ls),
+                rad: opts.shank_radius(),
+            },
+            ToolCylinder {
+                set: self.holder(),
+                span: (ls, ls + lh),
+                rad: opts.holder_radius_mm,
+            },
+        ]
     }
 
     /// Poses to check (counting the end) for a tool moving from ball centre `c0` and unit
@@ -138,29 +155,40 @@ impl Clearance {
 
     /// True if the shank and holder at `c` along `axis` are clear of the model.
     pub fn clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
-        let (f, ls, lh) = (
-            opts.flute_length(),
-            opts.shank_length_mm,
-            opts.holder_length_mm,
-        );
-        let shank = || grown_hit(&self.shank, c, axis, (f, ls), opts.shank_radius()).is_some();
-        let holder =
-            || grown_hit(self.holder(), c, axis, (ls, ls + lh), opts.holder_radius_mm).is_some();
+        let [shank, holder] = self.cylinders(opts);
         // Which of the two meets the model does not change the answer, only its cost.
         let holder_first = self.holder_first.load(Relaxed);
-        let (first, second): (&dyn Fn() -> bool, &dyn Fn() -> bool) = if holder_first {
-            (&holder, &shank)
+        let (first, second) = if holder_first {
+            (holder, shank)
         } else {
-            (&shank, &holder)
+            (shank, holder)
         };
-        if first() {
+        if first.hit(c, axis).is_some() {
             return false;
         }
-        if second() {
+        if second.hit(c, axis).is_some() {
             self.holder_first.store(!holder_first, Relaxed);
             return false;
         }
         true
+    }
+}
+
+/// A cylinder of the tool above the ball centre (mm) and the triangles it is tested
+/// against.
+#[derive(Clone, Copy)]
+struct ToolCylinder<'a> {
+    set: &'a SurfaceDistance,
+    /// From and to along the axis, above the ball centre.
+    span: (f64, f64),
+    rad: f64,
+}
+
+impl ToolCylinder<'_> {
+    /// A triangle point inside it at ball centre `c` along unit `axis` (grown by the
+    /// triangles' deviation from the surface), if there is one.
+    fn hit(&self, c: &Point3, axis: &Vector3) -> Option<Point3> {
+        grown_hit(self.set, c, axis, self.span, self.rad)
     }
 }
 
@@ -265,11 +293,11 @@ mod tests {
             .with_holder(1.0, 6.0, 6.0, 30.0);
         opts.flute_length_mm = Some(1.0);
         let obs = Clearance::new(&m, &opts);
-        let (f, ls, lh) = (1.0, 6.0, 30.0);
-        let only = |c: &Point3, a: &Vector3, holder: bool| {
-            let s = grown_hit(&obs.shank, c, a, (f, ls), 1.0).is_some();
-            let h = grown_hit(obs.holder(), c, a, (ls, ls + lh), 6.0).is_some();
-            if holder {
+        let [shank, holder] = obs.cylinders(&opts);
+        let only = |c: &Point3, a: &Vector3, by_holder: bool| {
+            let s = shank.hit(c, a).is_some();
+            let h = holder.hit(c, a).is_some();
+            if by_holder {
                 h && !s
             } else {
                 s && !h
