@@ -525,3 +525,69 @@ fn grid_and_line_evaluation_equal_point_by_point_bit_for_bit() {
     );
     assert!(lines > 10_000, "{lines} points along lines");
 }
+
+/// Largest difference between two sets of derivatives, relative to `scale` plus the size of
+/// each of the second's.
+fn derivs_gap(
+    a: &tspath::surface::SurfaceDerivs,
+    b: &tspath::surface::SurfaceDerivs,
+    scale: f64,
+) -> f64 {
+    let rel = |x: Vector3, y: Vector3| (x - y).norm() / (scale + y.norm());
+    rel(a.point.coords, b.point.coords)
+        .max(rel(a.su, b.su))
+        .max(rel(a.sv, b.sv))
+        .max(rel(a.suu, b.suu))
+        .max(rel(a.suv, b.suv))
+        .max(rel(a.svv, b.svv))
+}
+
+#[test]
+fn lines_v_const_equal_point_evaluation_to_rounding() {
+    // The planner's passes along u read faces by lines v = const (columns contracted once
+    // per cell); the sums run in the other order than point by point, so the numbers agree
+    // to rounding, not bit for bit: at most 1e-12 of the model size plus the value.
+    use tspath::surface::Held;
+    let ts = [0.0, 1e-3, 0.2, 0.5, 0.77, 0.999, 1.0];
+    let (mut points, mut worst) = (0usize, 0.0f64);
+    for s in SAMPLES {
+        let m = samples::load_sample(s.name).unwrap();
+        let size = m.surface.bbox().diagonal();
+        for f in m.surface.faces() {
+            let (ub, vb) = f.breaks();
+            let mut us: Vec<f64> = ts.iter().chain(ub).copied().collect();
+            us.extend(ub.iter().map(|b| (b - 1e-9).max(0.0)));
+            let back: Vec<f64> = us.iter().rev().copied().collect();
+            us.extend(back);
+            for &v in ts.iter().chain(vb) {
+                let mut line = f.line(Held::V, v);
+                assert_eq!(line.held_at(), (Held::V, v));
+                for &u in &us {
+                    points += 1;
+                    let d = f.derivs(u, v);
+                    worst = worst.max(derivs_gap(&line.derivs(u), &d, size));
+                    let (p, su, sv) = line.first_derivs(u);
+                    let first = tspath::surface::SurfaceDerivs {
+                        point: p,
+                        su,
+                        sv,
+                        ..d
+                    };
+                    worst = worst.max(derivs_gap(&first, &d, size));
+                }
+            }
+            // Lines u = const built the same way are the faces' own numbers, bit for bit.
+            for &u in ts.iter().chain(ub) {
+                let mut line = f.line(Held::U, u);
+                for &v in &us {
+                    assert_eq!(line.derivs(v), f.derivs(u, v), "{} at ({u}, {v})", s.name);
+                    let (p, su, sv) = line.first_derivs(v);
+                    assert_eq!((p, su, sv), f.first_derivs(u, v), "{}", s.name);
+                }
+            }
+        }
+    }
+    println!("{points} points on lines v = const: worst relative gap {worst:.1e}");
+    assert!(points > 10_000, "{points}");
+    assert!(worst < 1e-12, "{worst:e}");
+}

@@ -337,3 +337,63 @@ fn a_rectangle_reaching_a_patch_side_reaches_its_faces_sides() {
         println!("{file}: {split} piece sides inside faces, each met exactly");
     }
 }
+
+#[test]
+fn patch_lines_give_the_patchs_own_numbers() {
+    // The planner evaluates passes (and lines across them) by PatchLine: the numbers of
+    // Patch::derivs, derivs_normal and point_normal, bit for bit where the piece's face holds
+    // its u, to rounding where it holds its v; on every patch of every sample, both ways,
+    // forwards and back across pieces.
+    let xs: Vec<f64> = (0..=40).map(|k| k as f64 / 40.0).collect();
+    let back: Vec<f64> = xs.iter().rev().copied().collect();
+    let (mut exact, mut close, mut worst) = (0usize, 0usize, 0.0f64);
+    for s in SAMPLES {
+        let m = samples::load_sample(s.name).unwrap();
+        let size = m.surface.bbox().diagonal();
+        let rel =
+            |a: tspath::geom::Vector3, b: tspath::geom::Vector3| (a - b).norm() / (size + b.norm());
+        for p in &m.layout.patches {
+            for along_u in [true, false] {
+                for &at in &[0.0, 0.13, 0.5, 0.871, 1.0] {
+                    let mut line = p.line(&m.surface, along_u, at);
+                    for &x in xs.iter().chain(&back) {
+                        let (u, v) = if along_u { (x, at) } else { (at, x) };
+                        let d = p.derivs(&m.surface, u, v);
+                        let (ld, ln) = line.derivs_normal(x);
+                        let (dn, nn) = p.derivs_normal(&m.surface, u, v);
+                        assert_eq!(dn, d);
+                        let (lp, lpn) = line.point_normal(x);
+                        let (pp, pn) = p.point_normal(&m.surface, u, v);
+                        assert_eq!(ln.is_some(), nn.is_some(), "{}", s.name);
+                        assert_eq!(lpn.is_some(), pn.is_some(), "{}", s.name);
+                        if line.derivs(x) == d && ld == d && ln == nn && (lp, lpn) == (pp, pn) {
+                            exact += 1;
+                            continue;
+                        }
+                        close += 1;
+                        let mut gap = [
+                            rel(ld.point.coords, d.point.coords),
+                            rel(ld.su, d.su),
+                            rel(ld.sv, d.sv),
+                            rel(ld.suu, d.suu),
+                            rel(ld.suv, d.suv),
+                            rel(ld.svv, d.svv),
+                            rel(lp.coords, pp.coords),
+                        ]
+                        .into_iter()
+                        .fold(0.0, f64::max);
+                        for (a, b) in [(ln, nn), (lpn, pn)] {
+                            if let (Some(a), Some(b)) = (a, b) {
+                                gap = gap.max((a - b).norm());
+                            }
+                        }
+                        worst = worst.max(gap);
+                    }
+                }
+            }
+        }
+    }
+    println!("patch lines: {exact} points bit for bit, {close} to rounding (worst {worst:.1e})");
+    assert!(exact > 1000 && close > 1000, "{exact} exact, {close} close");
+    assert!(worst < 1e-12, "{worst:e}");
+}

@@ -15,8 +15,9 @@
 
 pub mod cuts;
 
-use crate::geom::Point3;
-use crate::surface::{Surface, SurfaceDerivs};
+use crate::geom::{Point3, Vector3};
+use crate::surface::diffgeom::unit_normal;
+use crate::surface::{FaceLine, FaceSurface, Held, Surface, SurfaceDerivs};
 use crate::tmesh::walk::{rot, unit, LineStep};
 use crate::tmesh::{TMesh, KNOT_MATCH_REL};
 use serde::{Deserialize, Serialize};
@@ -749,6 +750,121 @@ fn chart_rect(r: &[f64; 4], (k, off): Placement) -> ([f64; 2], [f64; 2]) {
     )
 }
 
+/// An iso-line of a patch, `v = const` or `u = const`: the numbers of [`Patch::derivs`],
+/// [`Patch::derivs_normal`] and [`Patch::point_normal`] at its points, with each face's
+/// contraction across the line done once per Bézier cell (see
+/// [`crate::surface::FaceLine`]: bit for bit where the face holds its `u`, up to rounding
+/// where it holds its `v`).
+pub struct PatchLine<'a> {
+    patch: &'a Patch,
+    surface: &'a Surface,
+    /// The line `v = at` (`u` runs), else `u = at`.
+    along_u: bool,
+    at: f64,
+    /// The chart cell (row or column) holding the line.
+    held_cell: usize,
+    /// The chart cell last evaluated along the line, and the chart coordinates it covers
+    /// (`[lo, hi)`, unbounded at the chart's ends: those [`chart_cell`] gives it).
+    run_cell: Option<(usize, f64, f64)>,
+    /// The piece last evaluated and its face's line.
+    face_line: Option<(usize, FaceLine<'a>)>,
+}
+
+/// Chart cell of `x` along `breaks` (clamped to the first and last).
+fn chart_cell(breaks: &[f64], x: f64) -> usize {
+    let n = breaks.len() - 1;
+    breaks[1..n].partition_point(|&b| b <= x).min(n - 1)
+}
+
+impl<'a> PatchLine<'a> {
+    /// The piece at running parameter `x`, its face, the face's parameters there and its
+    /// line through them with the running face parameter.
+    fn at(&mut self, x: f64) -> (&'a Piece, &'a FaceSurface, [f64; 2], &mut FaceLine<'a>, f64) {
+        let patch = self.patch;
+        let (u, v) = if self.along_u {
+            (x, self.at)
+        } else {
+            (self.at, x)
+        };
+        let (s, t) = (u * patch.width, v * patch.height);
+        let (x_run, breaks) = if self.along_u {
+            (s, &patch.s_breaks)
+        } else {
+            (t, &patch.t_breaks)
+        };
+        let cell = match self.run_cell {
+            Some((c, lo, hi)) if lo <= x_run && x_run < hi => c,
+            _ => {
+                let c = chart_cell(breaks, x_run);
+                let n = breaks.len() - 1;
+                let lo = if c == 0 { f64::NEG_INFINITY } else { breaks[c] };
+                let hi = if c + 1 == n {
+                    f64::INFINITY
+                } else {
+                    breaks[c + 1]
+                };
+                self.run_cell = Some((c, lo, hi));
+                c
+            }
+        };
+        let (i, j) = if self.along_u {
+            (cell, self.held_cell)
+        } else {
+            (self.held_cell, cell)
+        };
+        let (k, [x, y]) = patch.piece_in(i, j, s, t);
+        let p = &patch.pieces[k];
+        let face = &self.surface.faces()[p.face as usize];
+        let ab = [x / face.width, y / face.height];
+        // A quarter turn swaps the chart's axes in the face.
+        let held = if self.along_u == (p.quarter_turns % 2 == 0) {
+            Held::V
+        } else {
+            Held::U
+        };
+        let (fixed, run) = match held {
+            Held::U => (ab[0], ab[1]),
+            Held::V => (ab[1], ab[0]),
+        };
+        if self.face_line.as_ref().is_some_and(|(c, _)| *c != k) {
+            self.face_line = None;
+        }
+        debug_assert!(self
+            .face_line
+            .as_ref()
+            .is_none_or(|(_, line)| line.held_at() == (held, fixed)));
+        let line = &mut self
+            .face_line
+            .get_or_insert_with(|| (k, face.line(held, fixed)))
+            .1;
+        (p, face, ab, line, run)
+    }
+
+    /// Point and derivatives at running parameter `x` (as [`Patch::derivs`]).
+    pub fn derivs(&mut self, x: f64) -> SurfaceDerivs {
+        let patch = self.patch;
+        let (p, face, _, line, run) = self.at(x);
+        let d = line.derivs(run);
+        patch.to_patch(p, face, d)
+    }
+
+    /// Derivatives and unit normal at running parameter `x` (as [`Patch::derivs_normal`]).
+    pub fn derivs_normal(&mut self, x: f64) -> (SurfaceDerivs, Option<Vector3>) {
+        let patch = self.patch;
+        let (p, face, [a, b], line, run) = self.at(x);
+        let d = line.derivs(run);
+        let normal = unit_normal(&d.su, &d.sv).or_else(|| face.normal(a, b));
+        (patch.to_patch(p, face, d), normal)
+    }
+
+    /// Point and unit normal at running parameter `x` (as [`Patch::point_normal`]).
+    pub fn point_normal(&mut self, x: f64) -> (Point3, Option<Vector3>) {
+        let (_, face, [a, b], line, run) = self.at(x);
+        let (point, su, sv) = line.first_derivs(run);
+        (point, unit_normal(&su, &sv).or_else(|| face.normal(a, b)))
+    }
+}
+
 impl Patch {
     fn from_cells(cells: &Cells, chunk: &[(usize, Placement)]) -> Patch {
         let mut pieces = Vec::with_capacity(chunk.len());
@@ -874,22 +990,47 @@ impl Patch {
 
     /// The piece at chart point `(s, t)` and the face-knot coordinates there.
     fn locate(&self, s: f64, t: f64) -> (&Piece, [f64; 2]) {
-        let ns = self.s_breaks.len() - 1;
-        let nt = self.t_breaks.len() - 1;
-        let i = self.s_breaks[1..ns]
-            .partition_point(|&b| b <= s)
-            .min(ns - 1);
-        let j = self.t_breaks[1..nt]
-            .partition_point(|&b| b <= t)
-            .min(nt - 1);
-        let p = &self.pieces[self.cell_piece[j * ns + i] as usize];
+        let (k, xy) = self.locate_index(s, t);
+        (&self.pieces[k], xy)
+    }
+
+    /// [`Patch::locate`] with the piece's index.
+    fn locate_index(&self, s: f64, t: f64) -> (usize, [f64; 2]) {
+        let i = chart_cell(&self.s_breaks, s);
+        let j = chart_cell(&self.t_breaks, t);
+        self.piece_in(i, j, s, t)
+    }
+
+    /// The piece of chart cell `(i, j)` and the face-knot coordinates of `(s, t)` there.
+    fn piece_in(&self, i: usize, j: usize, s: f64, t: f64) -> (usize, [f64; 2]) {
+        let k = self.cell_piece[j * (self.s_breaks.len() - 1) + i] as usize;
+        let p = &self.pieces[k];
         let local = rot(
             (4 - p.quarter_turns) % 4,
             [s - p.offset[0], t - p.offset[1]],
         );
         let x = local[0].clamp(p.local[0], p.local[1]);
         let y = local[1].clamp(p.local[2], p.local[3]);
-        (p, [x, y])
+        (k, [x, y])
+    }
+
+    /// The iso-line `v = at` (`along_u`) or `u = at` of the patch, for many evaluations along
+    /// it: see [`PatchLine`].
+    pub fn line<'a>(&'a self, surface: &'a Surface, along_u: bool, at: f64) -> PatchLine<'a> {
+        let (breaks, size) = if along_u {
+            (&self.t_breaks, self.height)
+        } else {
+            (&self.s_breaks, self.width)
+        };
+        PatchLine {
+            patch: self,
+            surface,
+            along_u,
+            at,
+            held_cell: chart_cell(breaks, at * size),
+            run_cell: None,
+            face_line: None,
+        }
     }
 
     /// Point and derivatives at patch parameters `(u, v)` in `[0,1]²`.

@@ -18,7 +18,7 @@ use super::toolpath::{PatchRun, Toolpath};
 use super::PlanOptions;
 use crate::error::{Error, Result};
 use crate::geom::{dist_to_segment, Point3, Vector3};
-use crate::layout::{ConnectionKind, Patch};
+use crate::layout::{ConnectionKind, Patch, PatchLine};
 use crate::model::Model;
 use crate::surface::diffgeom::unit_normal;
 use crate::surface::{DiffGeom, Surface, SurfaceDerivs};
@@ -62,6 +62,9 @@ pub trait ParamSurface {
     fn derivs_normal(&self, u: f64, v: f64) -> (SurfaceDerivs, Option<Vector3>);
     /// Where this is, for error messages.
     fn label(&self) -> String;
+    /// The iso-line along `dir` at across-parameter `w` (`at(dir, t, w)` for running `t`),
+    /// for many evaluations along it.
+    fn line(&self, dir: FeedDir, w: f64) -> Box<dyn ParamLine + '_>;
     /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other.
     fn side(&self) -> f64 {
         1.0
@@ -120,12 +123,49 @@ impl ParamSurface for PatchView<'_> {
     fn label(&self) -> String {
         format!("patch {}", self.index)
     }
+    fn line(&self, dir: FeedDir, w: f64) -> Box<dyn ParamLine + '_> {
+        Box::new(ViewLine {
+            line: self.patch.line(self.surface, dir == FeedDir::AlongU, w),
+            side: self.side,
+        })
+    }
+}
+
+/// An iso-line of a [`ParamSurface`] (a pass, or a line across the passes) evaluated at many
+/// points of its running parameter `t`: the numbers the surface gives at `at(dir, t, w)`,
+/// found with less work per point.
+pub trait ParamLine {
+    fn derivs(&mut self, t: f64) -> SurfaceDerivs;
+    /// Point and tool-side unit normal.
+    fn point_normal(&mut self, t: f64) -> (Point3, Option<Vector3>);
+    /// Derivatives and tool-side unit normal.
+    fn derivs_normal(&mut self, t: f64) -> (SurfaceDerivs, Option<Vector3>);
+}
+
+/// A patch's iso-line with the tool side's normals.
+struct ViewLine<'a> {
+    line: PatchLine<'a>,
+    side: f64,
+}
+
+impl ParamLine for ViewLine<'_> {
+    fn derivs(&mut self, t: f64) -> SurfaceDerivs {
+        self.line.derivs(t)
+    }
+    fn point_normal(&mut self, t: f64) -> (Point3, Option<Vector3>) {
+        let (p, n) = self.line.point_normal(t);
+        (p, n.map(|n| n * self.side))
+    }
+    fn derivs_normal(&mut self, t: f64) -> (SurfaceDerivs, Option<Vector3>) {
+        let (d, n) = self.line.derivs_normal(t);
+        (d, n.map(|n| n * self.side))
+    }
 }
 
 /// Fundamental forms at a point; `None` at a singular point (an extraordinary point's limit),
 /// where curvature is undefined and must not enter step computations.
-fn geom_at(s: &dyn ParamSurface, u: f64, v: f64) -> Option<DiffGeom> {
-    let g = DiffGeom::try_from_derivs(&s.derivs(u, v))?;
+fn geom_of(s: &dyn ParamSurface, d: &SurfaceDerivs) -> Option<DiffGeom> {
+    let g = DiffGeom::try_from_derivs(d)?;
     Some(if s.side() < 0.0 { g.flipped() } else { g })
 }
 
@@ -150,9 +190,11 @@ fn at(dir: FeedDir, t: f64, w: f64) -> (f64, f64) {
 /// (concave curvature tighter than the ball clamped, see [`stepover::side_step_clamped`]).
 fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> f64 {
     let mut best = f64::INFINITY;
+    let mut line = s.line(dir, w);
     for t in pass_samples() {
-        let (u, v) = at(dir, t, w);
-        let Some(dg) = geom_at(s, u, v) else { continue };
+        let Some(dg) = geom_of(s, &line.derivs(t)) else {
+            continue;
+        };
         let kappa = stepover::cross_curvature(&dg, dir);
         let g = stepover::side_step_clamped(h, r, kappa);
         best = best.min(stepover::param_side_step(&dg, dir, g));
@@ -254,11 +296,9 @@ pub(crate) fn predicted(s: &dyn ParamSurface, dir: FeedDir, ws: &[f64], r: f64) 
     let mut sorted = ws.to_vec();
     sorted.sort_by(f64::total_cmp);
     let row = |w: f64| -> Vec<Option<DiffGeom>> {
+        let mut line = s.line(dir, w.min(1.0));
         pass_samples()
-            .map(|t| {
-                let (u, v) = at(dir, t, w.min(1.0));
-                geom_at(s, u, v)
-            })
+            .map(|t| geom_of(s, &line.derivs(t)))
             .collect()
     };
     let worst_on = |row: &[Option<DiffGeom>], dw: f64| -> f64 {
@@ -411,10 +451,10 @@ struct Sweep {
 /// `S_t + r n_t` from the derivatives where the surface has a normal (`n_t` the derivative
 /// of `S_u × S_v / |S_u × S_v|`), else by a finite difference.
 fn sweeps(s: &dyn ParamSurface, dir: FeedDir, w: f64, r: f64) -> Result<Vec<Sweep>> {
+    let mut line = s.line(dir, w);
     pass_samples()
         .map(|t| {
-            let (u, v) = at(dir, t, w);
-            let (d, n) = s.derivs_normal(u, v);
+            let (d, n) = line.derivs_normal(t);
             let cc = match n {
                 Some(n) => (d.point, n),
                 // No normal here or nearby: pass_point says so.
@@ -463,7 +503,9 @@ fn cusp_between(
     tol: f64,
 ) -> Result<f64> {
     let mut worst: f64 = 0.0;
+    let across = dir.other();
     for ((t, p0), p1) in pass_samples().zip(s0).zip(s1) {
+        let mut line = s.line(across, t);
         // Material left by each pass at a point with normal n.
         let left_at = |(q, n): (Point3, Vector3)| -> (f64, f64) {
             (
@@ -471,8 +513,9 @@ fn cusp_between(
                 left_by_swept_ball(&q, &n, (&p1.cl, &p1.tangent), r),
             )
         };
-        let left = |x: f64| -> Result<(f64, f64)> {
-            Ok(left_at(pass_point(s, dir, t, w0 + x * (w1 - w0))?))
+        let mut left = |x: f64| -> Result<(f64, f64)> {
+            let w = w0 + x * (w1 - w0);
+            Ok(left_at(line_point(s, &mut *line, across, w, t)?))
         };
         // g = a − b rises across the gap: the first pass leaves least on its own line.
         let g = |(a, b): (f64, f64)| a - b;
@@ -578,7 +621,28 @@ fn cusp_checked(
 /// Contact point and unit normal on a pass.
 fn pass_point(s: &dyn ParamSurface, dir: FeedDir, t: f64, w: f64) -> Result<(Point3, Vector3)> {
     let (u, v) = at(dir, t, w);
-    let (p, n) = s.point_normal(u, v);
+    with_normal(s, u, v, s.point_normal(u, v))
+}
+
+/// [`pass_point`] from `line`, the surface's line along `dir` at `w`.
+fn line_point(
+    s: &dyn ParamSurface,
+    line: &mut dyn ParamLine,
+    dir: FeedDir,
+    t: f64,
+    w: f64,
+) -> Result<(Point3, Vector3)> {
+    let (u, v) = at(dir, t, w);
+    with_normal(s, u, v, line.point_normal(t))
+}
+
+/// A contact point with its normal, or the error that `(u, v)` of `s` has none.
+fn with_normal(
+    s: &dyn ParamSurface,
+    u: f64,
+    v: f64,
+    (p, n): (Point3, Option<Vector3>),
+) -> Result<(Point3, Vector3)> {
     let n = n.ok_or_else(|| Error::Degenerate {
         location: format!("{} at (u, v) = ({u:.6}, {v:.6})", s.label()),
         message: "the surface has no tangent plane here or nearby".into(),
@@ -608,21 +672,24 @@ pub fn forward_steps(
 ) -> Result<Vec<(f64, Point3, Vector3)>> {
     let (tol, dip, leave) = (lim.contact, lim.overcut, lim.leave);
     let mut t = 0.0;
-    let mut p0 = pass_point(s, dir, 0.0, w)?;
+    let mut line = s.line(dir, w);
+    let mut p0 = line_point(s, &mut *line, dir, 0.0, w)?;
     let mut out = vec![(0.0, p0.0, p0.1)];
     // Points of the last try by parameter: halving a step makes its middle the next try's
     // end and its quarter the next try's middle.
     let mut tried: Vec<(f64, (Point3, Vector3))> = Vec::with_capacity(4);
     let mut now: Vec<(f64, (Point3, Vector3))> = Vec::with_capacity(4);
-    let point = |x: f64, tried: &[(f64, (Point3, Vector3))]| -> Result<(Point3, Vector3)> {
+    let point = |line: &mut dyn ParamLine,
+                 x: f64,
+                 tried: &[(f64, (Point3, Vector3))]|
+     -> Result<(Point3, Vector3)> {
         match tried.iter().find(|(y, _)| *y == x) {
             Some(&(_, p)) => Ok(p),
-            None => pass_point(s, dir, x, w),
+            None => line_point(s, line, dir, x, w),
         }
     };
     while t < 1.0 {
-        let (u, v) = at(dir, t, w);
-        let d = s.derivs(u, v);
+        let d = line.derivs(t);
         let (c1, c2) = match dir {
             FeedDir::AlongU => (d.su, d.suu),
             FeedDir::AlongV => (d.sv, d.svv),
@@ -645,7 +712,7 @@ pub fn forward_steps(
         tried.clear();
         for _ in 0..MAX_HALVINGS {
             now.clear();
-            let p1 = point(t + dt, &tried)?;
+            let p1 = point(&mut *line, t + dt, &tried)?;
             now.push((t + dt, p1));
             let cl = |p: &(Point3, Vector3)| p.0 + p.1 * r;
             let (a, b) = (cl(&p0), cl(&p1));
@@ -654,7 +721,7 @@ pub fn forward_steps(
             // (where the curvature varies the largest gap is off the middle).
             let mut ok = true;
             for f in CHORD_PROBES {
-                let pm = point(t + f * dt, &tried)?;
+                let pm = point(&mut *line, t + f * dt, &tried)?;
                 now.push((t + f * dt, pm));
                 let m = cl(&pm);
                 let along = if ab.norm_squared() > 0.0 {
@@ -686,7 +753,7 @@ pub fn forward_steps(
         if 1.0 - (t + dt) < 1e-12 {
             // The pass ends exactly at its side.
             t = 1.0;
-            p0 = pass_point(s, dir, 1.0, w)?;
+            p0 = line_point(s, &mut *line, dir, 1.0, w)?;
         } else {
             t += dt;
             p0 = p1;
@@ -1027,10 +1094,7 @@ fn link_between(
     patch: u32,
     line: u32,
 ) -> Result<()> {
-    let other = match dir {
-        FeedDir::AlongU => FeedDir::AlongV,
-        FeedDir::AlongV => FeedDir::AlongU,
-    };
+    let other = dir.other();
     let (a, b) = (w0.min(w1), w0.max(w1));
     // Points between the passes on the boundary line, by the same chordal rule.
     let mut inner = Vec::new();

@@ -15,6 +15,16 @@ pub enum FeedDir {
     AlongV,
 }
 
+impl FeedDir {
+    /// The direction across: along the other parameter.
+    pub fn other(self) -> FeedDir {
+        match self {
+            FeedDir::AlongU => FeedDir::AlongV,
+            FeedDir::AlongV => FeedDir::AlongU,
+        }
+    }
+}
+
 /// Physical side step `g` (mm) between two passes of a ball of radius `r` (mm) that leaves
 /// scallops of height `h` (mm) on a surface whose normal curvature across the feed is
 /// `kappa` (1/mm, sign as in [`DiffGeom`]: negative where convex towards the tool).

@@ -133,7 +133,6 @@ impl BezierPatch {
     /// points with normals, which need only these).
     pub fn first_derivs(&self, u: f64, v: f64) -> (Point3, Vector3, Vector3) {
         let (bu, dbu, _) = bernstein3(u);
-        let (bv, dbv, _) = bernstein3(v);
         let mut r0 = [Vector4::zeros(); 4];
         let mut r1 = [Vector4::zeros(); 4];
         for j in 0..4 {
@@ -143,19 +142,8 @@ impl BezierPatch {
                 r1[j] += c * dbu[i];
             }
         }
-        let mut a = Vector4::zeros();
-        let mut au = Vector4::zeros();
-        let mut av = Vector4::zeros();
-        for j in 0..4 {
-            a += r0[j] * bv[j];
-            av += r0[j] * dbv[j];
-            au += r1[j] * bv[j];
-        }
-        let inv = 1.0 / a.w;
-        let s = a.xyz() * inv;
-        let su = (au.xyz() - s * au.w) * inv;
-        let sv = (av.xyz() - s * av.w) * inv;
-        (Point3::from(s), su, sv)
+        let [a, a_run, a_held] = finish_first(&r0, &r1, v);
+        rational_first(a, a_held, a_run)
     }
 
     /// Point with first and second partial derivatives at `(u, v)`.
@@ -191,28 +179,106 @@ impl BezierPatch {
         [r0, r1, r2]
     }
 
+    /// The columns contracted along `v`: value, d/dv and d²/dv² of each column `i` (the
+    /// transpose of [`BezierPatch::rows_at`], for lines `v = const`).
+    #[inline]
+    pub(crate) fn cols_at(&self, v: f64) -> Rows {
+        let (bv, dbv, ddbv) = bernstein3(v);
+        let mut c0 = [Vector4::zeros(); 4];
+        let mut c1 = [Vector4::zeros(); 4];
+        let mut c2 = [Vector4::zeros(); 4];
+        for j in 0..4 {
+            for i in 0..4 {
+                let c = self.cp[j][i];
+                c0[i] += c * bv[j];
+                c1[i] += c * dbv[j];
+                c2[i] += c * ddbv[j];
+            }
+        }
+        [c0, c1, c2]
+    }
+
     /// Point and derivatives at `v` from the rows of [`BezierPatch::rows_at`]`(u)`: those of
     /// `(u, v)`.
     #[inline]
     pub(crate) fn finish_derivs(rows: &Rows, v: f64) -> SurfaceDerivs {
-        let [r0, r1, r2] = rows;
-        let (bv, dbv, ddbv) = bernstein3(v);
-        let mut a = Vector4::zeros();
-        let mut au = Vector4::zeros();
-        let mut av = Vector4::zeros();
-        let mut auu = Vector4::zeros();
-        let mut auv = Vector4::zeros();
-        let mut avv = Vector4::zeros();
-        for j in 0..4 {
-            a += r0[j] * bv[j];
-            av += r0[j] * dbv[j];
-            avv += r0[j] * ddbv[j];
-            au += r1[j] * bv[j];
-            auv += r1[j] * dbv[j];
-            auu += r2[j] * bv[j];
-        }
-        rational_derivs(a, au, av, auu, auv, avv)
+        let [a, a_held, a_run, a_hh, a_hr, a_rr] = finish_contracted(rows, v);
+        rational_derivs(a, a_held, a_run, a_hh, a_hr, a_rr)
     }
+
+    /// Point and derivatives at `u` from the columns of [`BezierPatch::cols_at`]`(v)`: those
+    /// of `(u, v)` up to rounding (the sums run in the other order).
+    #[inline]
+    pub(crate) fn finish_derivs_cols(cols: &Rows, u: f64) -> SurfaceDerivs {
+        let [a, a_held, a_run, a_hh, a_hr, a_rr] = finish_contracted(cols, u);
+        rational_derivs(a, a_run, a_held, a_rr, a_hr, a_hh)
+    }
+
+    /// Point and first derivatives `(S, S_u, S_v)` at `v` from [`BezierPatch::rows_at`]`(u)`:
+    /// those of [`BezierPatch::first_derivs`] bit for bit.
+    #[inline]
+    pub(crate) fn finish_first(rows: &Rows, v: f64) -> (Point3, Vector3, Vector3) {
+        let [a, a_run, a_held] = finish_first(&rows[0], &rows[1], v);
+        rational_first(a, a_held, a_run)
+    }
+
+    /// Point and first derivatives `(S, S_u, S_v)` at `u` from
+    /// [`BezierPatch::cols_at`]`(v)`.
+    #[inline]
+    pub(crate) fn finish_first_cols(cols: &Rows, u: f64) -> (Point3, Vector3, Vector3) {
+        let [a, a_run, a_held] = finish_first(&cols[0], &cols[1], u);
+        rational_first(a, a_run, a_held)
+    }
+}
+
+/// Homogeneous value and derivatives at `x` of a patch contracted across a line (`rows`:
+/// value, first and second derivative across it, each a cubic in the running parameter
+/// `x`): `[a, a_h, a_r, a_hh, a_hr, a_rr]`, `h` the held parameter and `r` the running one.
+#[inline]
+fn finish_contracted(rows: &Rows, x: f64) -> [Vector4; 6] {
+    let [r0, r1, r2] = rows;
+    let (b, db, ddb) = bernstein3(x);
+    let mut a = Vector4::zeros();
+    let mut a_h = Vector4::zeros();
+    let mut a_r = Vector4::zeros();
+    let mut a_hh = Vector4::zeros();
+    let mut a_hr = Vector4::zeros();
+    let mut a_rr = Vector4::zeros();
+    for j in 0..4 {
+        a += r0[j] * b[j];
+        a_r += r0[j] * db[j];
+        a_rr += r0[j] * ddb[j];
+        a_h += r1[j] * b[j];
+        a_hr += r1[j] * db[j];
+        a_hh += r2[j] * b[j];
+    }
+    [a, a_h, a_r, a_hh, a_hr, a_rr]
+}
+
+/// Homogeneous value and first derivatives at `x` (`[a, a_r, a_h]`) from the value and
+/// cross-derivative contractions `r0`, `r1` of a patch (see [`finish_contracted`]).
+#[inline]
+fn finish_first(r0: &[Vector4; 4], r1: &[Vector4; 4], x: f64) -> [Vector4; 3] {
+    let (b, db, _) = bernstein3(x);
+    let mut a = Vector4::zeros();
+    let mut a_h = Vector4::zeros();
+    let mut a_r = Vector4::zeros();
+    for j in 0..4 {
+        a += r0[j] * b[j];
+        a_r += r0[j] * db[j];
+        a_h += r1[j] * b[j];
+    }
+    [a, a_r, a_h]
+}
+
+/// Euclidean point and first derivatives from homogeneous ones (quotient rule).
+#[inline]
+fn rational_first(a: Vector4, au: Vector4, av: Vector4) -> (Point3, Vector3, Vector3) {
+    let inv = 1.0 / a.w;
+    let s = a.xyz() * inv;
+    let su = (au.xyz() - s * au.w) * inv;
+    let sv = (av.xyz() - s * av.w) * inv;
+    (Point3::from(s), su, sv)
 }
 
 /// A patch contracted along `u` ([`BezierPatch::rows_at`]).

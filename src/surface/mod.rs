@@ -81,46 +81,144 @@ fn local(breaks: &[f64], i: usize, x: f64) -> (f64, f64) {
     ((x - breaks[i]) / span, 1.0 / span)
 }
 
-/// A line `u = const` of a face: point and derivatives at any `v`, the numbers of
-/// [`FaceSurface::derivs`] bit for bit, with the contraction along `u` done once per Bézier
-/// cell the line crosses (about a quarter of the work per point after the first).
-pub struct ULine<'a> {
+/// Which parameter a [`FaceLine`] holds fixed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Held {
+    /// The line `u = const`; `v` runs.
+    U,
+    /// The line `v = const`; `u` runs.
+    V,
+}
+
+/// An iso-line of a face: point and derivatives at any value of the running parameter, with
+/// the contraction across the line done once per Bézier cell it crosses (about a quarter of
+/// the work per point after the first). On a line `u = const` these are the numbers of
+/// [`FaceSurface::derivs`] and [`FaceSurface::first_derivs`] bit for bit; on `v = const` the
+/// same up to rounding (the sums run in the other order).
+pub struct FaceLine<'a> {
     face: &'a FaceSurface,
-    u: f64,
-    /// The column of Bézier cells holding `u`.
-    cu: usize,
-    /// The cell last evaluated (its index in the face's cells) and its rows at `u`.
+    held: Held,
+    /// The held parameter's value.
+    at: f64,
+    /// The row or column of Bézier cells holding the line.
+    cell: usize,
+    /// The cell last evaluated (its index in the face's cells) and its contraction across
+    /// the line.
     rows: Option<(usize, bezier::Rows)>,
 }
 
-impl ULine<'_> {
-    /// Point and derivatives at `(u, v)`.
-    pub fn derivs(&mut self, v: f64) -> SurfaceDerivs {
+/// A Bézier cell contracted across a line, the running parameter's value in it, and the
+/// cell's scales to the face's parameters (`None` for a quadtree leaf over the whole face,
+/// with its origin instead).
+struct OnCell<'r> {
+    rows: &'r bezier::Rows,
+    run: f64,
+    scale: Option<[f64; 2]>,
+    origin: Option<&'r Vector3>,
+}
+
+impl FaceLine<'_> {
+    /// `(u, v)` at running parameter `x`.
+    fn uv(&self, x: f64) -> (f64, f64) {
+        match self.held {
+            Held::U => (self.at, x),
+            Held::V => (x, self.at),
+        }
+    }
+
+    /// The cell holding `x` contracted across the line; `None` on a subdivided quadtree face.
+    fn on_cell(&mut self, x: f64) -> Option<OnCell<'_>> {
+        let (u, v) = self.uv(x);
+        let held = self.held;
+        let contract = |p: &BezierPatch, at: f64| match held {
+            Held::U => p.rows_at(at),
+            Held::V => p.cols_at(at),
+        };
         match &self.face.form {
             FaceForm::Grid {
                 u_breaks,
                 v_breaks,
                 cells,
             } => {
-                let cell = [self.cu, cell_of(v_breaks, v)];
-                let (k, [tu, tv], [su, sv]) = grid_cell(u_breaks, v_breaks, cell, self.u, v);
-                let rows = match &mut self.rows {
-                    Some((at, rows)) if *at == k => rows,
-                    slot => &mut slot.insert((k, cells[k].rows_at(tu))).1,
+                let cell = match held {
+                    Held::U => [self.cell, cell_of(v_breaks, v)],
+                    Held::V => [cell_of(u_breaks, u), self.cell],
                 };
-                BezierPatch::finish_derivs(rows, tv).scaled(su, sv)
+                let (k, [tu, tv], scale) = grid_cell(u_breaks, v_breaks, cell, u, v);
+                let (at, run) = match held {
+                    Held::U => (tu, tv),
+                    Held::V => (tv, tu),
+                };
+                if self.rows.as_ref().is_some_and(|(c, _)| *c != k) {
+                    self.rows = None;
+                }
+                let rows = &self
+                    .rows
+                    .get_or_insert_with(|| (k, contract(&cells[k], at)))
+                    .1;
+                Some(OnCell {
+                    rows,
+                    run,
+                    scale: Some(scale),
+                    origin: None,
+                })
             }
             // One cell over the whole face, as in `for_each_derivs`.
             FaceForm::Tree(subdiv::Node::Leaf { patch, origin }) => {
-                let rows = match &mut self.rows {
-                    Some((_, rows)) => rows,
-                    slot => &mut slot.insert((0, patch.rows_at(self.u))).1,
-                };
-                let mut d = BezierPatch::finish_derivs(rows, v);
-                d.point += origin;
-                d
+                let at = self.at;
+                let rows = &self.rows.get_or_insert_with(|| (0, contract(patch, at))).1;
+                Some(OnCell {
+                    rows,
+                    run: x,
+                    scale: None,
+                    origin: Some(origin),
+                })
             }
-            FaceForm::Tree(_) => self.face.derivs(self.u, v),
+            FaceForm::Tree(_) => None,
+        }
+    }
+
+    /// The parameter held and its value.
+    pub fn held_at(&self) -> (Held, f64) {
+        (self.held, self.at)
+    }
+
+    /// Point and derivatives at running parameter `x`.
+    pub fn derivs(&mut self, x: f64) -> SurfaceDerivs {
+        let held = self.held;
+        let Some(c) = self.on_cell(x) else {
+            let (u, v) = self.uv(x);
+            return self.face.derivs(u, v);
+        };
+        let d = match held {
+            Held::U => BezierPatch::finish_derivs(c.rows, c.run),
+            Held::V => BezierPatch::finish_derivs_cols(c.rows, c.run),
+        };
+        match (c.scale, c.origin) {
+            (Some([su, sv]), _) => d.scaled(su, sv),
+            (None, Some(origin)) => SurfaceDerivs {
+                point: d.point + origin,
+                ..d
+            },
+            (None, None) => d,
+        }
+    }
+
+    /// Point and first derivatives `(S, S_u, S_v)` at running parameter `x`.
+    pub fn first_derivs(&mut self, x: f64) -> (Point3, Vector3, Vector3) {
+        let held = self.held;
+        let Some(c) = self.on_cell(x) else {
+            let (u, v) = self.uv(x);
+            return self.face.first_derivs(u, v);
+        };
+        let (p, du, dv) = match held {
+            Held::U => BezierPatch::finish_first(c.rows, c.run),
+            Held::V => BezierPatch::finish_first_cols(c.rows, c.run),
+        };
+        match (c.scale, c.origin) {
+            (Some([su, sv]), _) => (p, du * su, dv * sv),
+            (None, Some(origin)) => (p + origin, du, dv),
+            (None, None) => (p, du, dv),
         }
     }
 }
@@ -197,14 +295,21 @@ impl FaceSurface {
         }
     }
 
-    /// The line `u = const` of the face, for [`ULine::derivs`] at many `v`.
-    pub fn u_line(&self, u: f64) -> ULine<'_> {
-        ULine {
+    /// The iso-line holding `held` at `at`, for [`FaceLine::derivs`] at many points.
+    pub fn line(&self, held: Held, at: f64) -> FaceLine<'_> {
+        let (ub, vb) = self.breaks();
+        FaceLine {
             face: self,
-            u,
-            cu: cell_of(self.breaks().0, u),
+            held,
+            at,
+            cell: cell_of(if held == Held::U { ub } else { vb }, at),
             rows: None,
         }
+    }
+
+    /// The line `u = const` of the face, for [`FaceLine::derivs`] at many `v`.
+    pub fn u_line(&self, u: f64) -> FaceLine<'_> {
+        self.line(Held::U, u)
     }
 
     /// Point at `(u, v)` in `[0,1]²`.
