@@ -371,13 +371,17 @@ fn patch_lines_give_the_patchs_own_numbers() {
                             continue;
                         }
                         close += 1;
+                        // Each order against its largest value (see derivs_gap in
+                        // geometry.rs: a second derivative can be a small difference).
+                        let first = d.su.norm().max(d.sv.norm());
+                        let second = d.suu.norm().max(d.suv.norm()).max(d.svv.norm());
                         let mut gap = [
                             rel(ld.point.coords, d.point.coords),
-                            rel(ld.su, d.su),
-                            rel(ld.sv, d.sv),
-                            rel(ld.suu, d.suu),
-                            rel(ld.suv, d.suv),
-                            rel(ld.svv, d.svv),
+                            (ld.su - d.su).norm() / (size + first),
+                            (ld.sv - d.sv).norm() / (size + first),
+                            (ld.suu - d.suu).norm() / (size + second),
+                            (ld.suv - d.suv).norm() / (size + second),
+                            (ld.svv - d.svv).norm() / (size + second),
                             rel(lp.coords, pp.coords),
                         ]
                         .into_iter()

@@ -107,13 +107,12 @@ pub struct FaceLine<'a> {
     rows: Option<(usize, bezier::Rows)>,
 }
 
-/// A Bézier cell contracted across a line, the running parameter's value in it, and the
-/// cell's scales to the face's parameters (`None` for a quadtree leaf over the whole face,
-/// with its origin instead).
+/// A Bézier cell contracted across a line, the running parameter's value in it, the cell's
+/// scales to the face's parameters and (a quadtree leaf's) origin of its coordinates.
 struct OnCell<'r> {
     rows: &'r bezier::Rows,
     run: f64,
-    scale: Option<[f64; 2]>,
+    scale: [f64; 2],
     origin: Option<&'r Vector3>,
 }
 
@@ -159,22 +158,40 @@ impl FaceLine<'_> {
                 Some(OnCell {
                     rows,
                     run,
-                    scale: Some(scale),
+                    scale,
                     origin: None,
                 })
             }
-            // One cell over the whole face, as in `for_each_derivs`.
-            FaceForm::Tree(subdiv::Node::Leaf { patch, origin }) => {
-                let at = self.at;
-                let rows = &self.rows.get_or_insert_with(|| (0, contract(patch, at))).1;
+            // The quadtree's leaf holding the point (its cap: none), keyed by its address.
+            FaceForm::Tree(node) => {
+                let subdiv::Found::Leaf {
+                    patch,
+                    origin,
+                    uv,
+                    scale,
+                } = node.descend(u, v)
+                else {
+                    return None;
+                };
+                let (at, run) = match held {
+                    Held::U => (uv[0], uv[1]),
+                    Held::V => (uv[1], uv[0]),
+                };
+                let key = patch as *const BezierPatch as usize;
+                if self.rows.as_ref().is_some_and(|(c, _)| *c != key) {
+                    self.rows = None;
+                }
+                let rows = &self
+                    .rows
+                    .get_or_insert_with(|| (key, contract(patch, at)))
+                    .1;
                 Some(OnCell {
                     rows,
-                    run: x,
-                    scale: None,
+                    run,
+                    scale: [scale, scale],
                     origin: Some(origin),
                 })
             }
-            FaceForm::Tree(_) => None,
         }
     }
 
@@ -194,13 +211,13 @@ impl FaceLine<'_> {
             Held::U => BezierPatch::finish_derivs(c.rows, c.run),
             Held::V => BezierPatch::finish_derivs_cols(c.rows, c.run),
         };
-        match (c.scale, c.origin) {
-            (Some([su, sv]), _) => d.scaled(su, sv),
-            (None, Some(origin)) => SurfaceDerivs {
+        let d = d.scaled(c.scale[0], c.scale[1]);
+        match c.origin {
+            Some(origin) => SurfaceDerivs {
                 point: d.point + origin,
                 ..d
             },
-            (None, None) => d,
+            None => d,
         }
     }
 
@@ -215,10 +232,10 @@ impl FaceLine<'_> {
             Held::U => BezierPatch::finish_first(c.rows, c.run),
             Held::V => BezierPatch::finish_first_cols(c.rows, c.run),
         };
-        match (c.scale, c.origin) {
-            (Some([su, sv]), _) => (p, du * su, dv * sv),
-            (None, Some(origin)) => (p + origin, du, dv),
-            (None, None) => (p, du, dv),
+        let [su, sv] = c.scale;
+        match c.origin {
+            Some(origin) => (p + origin, du * su, dv * sv),
+            None => (p, du * su, dv * sv),
         }
     }
 }

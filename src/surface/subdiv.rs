@@ -98,7 +98,7 @@ pub enum Node {
 
 /// Where a point of a [`Node`] lies: in a leaf's Bézier cell (at `uv` there, the cell `scale`
 /// times smaller than the node), or on a cap.
-enum Found<'a> {
+pub(crate) enum Found<'a> {
     Leaf {
         patch: &'a BezierPatch,
         origin: &'a Vector3,
@@ -110,7 +110,7 @@ enum Found<'a> {
 
 impl Node {
     /// The leaf or cap holding `(u, v)` (in the node's square `[0,1]²`).
-    fn descend(&self, mut u: f64, mut v: f64) -> Found<'_> {
+    pub(crate) fn descend(&self, mut u: f64, mut v: f64) -> Found<'_> {
         let mut node = self;
         let mut scale = 1.0;
         loop {
