@@ -480,6 +480,16 @@ fn first_derivatives_alone_equal_the_full_evaluation_bit_for_bit() {
     assert!(trees > 0, "no subdivision face among the samples");
 }
 
+/// Parameters a line test visits: `ts`, the Bézier cells' `breaks` and just below each,
+/// forwards and back (a line keeps one cell's contraction while it stays there).
+fn along_a_line(ts: &[f64], breaks: &[f64]) -> Vec<f64> {
+    let mut xs: Vec<f64> = ts.iter().chain(breaks).copied().collect();
+    xs.extend(breaks.iter().map(|b| (b - 1e-9).max(0.0)));
+    let back: Vec<f64> = xs.iter().rev().copied().collect();
+    xs.extend(back);
+    xs
+}
+
 #[test]
 fn grid_and_line_evaluation_equal_point_by_point_bit_for_bit() {
     // Model::smallest_concave_radius and tool_side evaluate whole grids per face at once
@@ -504,10 +514,7 @@ fn grid_and_line_evaluation_equal_point_by_point_bit_for_bit() {
             // Lines u = const (the cutting simulation's columns): through every Bézier cell
             // and across its breaks, forwards and back (the line keeps one cell's rows).
             let (ub, vb) = f.breaks();
-            let mut vs: Vec<f64> = ts.iter().chain(vb).copied().collect();
-            vs.extend(vb.iter().map(|b| (b - 1e-9).max(0.0)));
-            let back: Vec<f64> = vs.iter().rev().copied().collect();
-            vs.extend(back);
+            let vs = along_a_line(&ts, vb);
             for &u in ts.iter().chain(ub) {
                 let mut line = f.u_line(u);
                 for &v in &vs {
@@ -558,10 +565,7 @@ fn lines_v_const_equal_point_evaluation_to_rounding() {
         let size = m.surface.bbox().diagonal();
         for f in m.surface.faces() {
             let (ub, vb) = f.breaks();
-            let mut us: Vec<f64> = ts.iter().chain(ub).copied().collect();
-            us.extend(ub.iter().map(|b| (b - 1e-9).max(0.0)));
-            let back: Vec<f64> = us.iter().rev().copied().collect();
-            us.extend(back);
+            let us = along_a_line(&ts, ub);
             for &v in ts.iter().chain(vb) {
                 let mut line = f.line(Held::V, v);
                 assert_eq!(line.held_at(), (Held::V, v));

@@ -164,38 +164,14 @@ impl BezierPatch {
     /// The rows contracted along `u`: value, d/du and d²/du² of each row `j`.
     #[inline]
     pub(crate) fn rows_at(&self, u: f64) -> Rows {
-        let (bu, dbu, ddbu) = bernstein3(u);
-        let mut r0 = [Vector4::zeros(); 4];
-        let mut r1 = [Vector4::zeros(); 4];
-        let mut r2 = [Vector4::zeros(); 4];
-        for j in 0..4 {
-            for i in 0..4 {
-                let c = self.cp[j][i];
-                r0[j] += c * bu[i];
-                r1[j] += c * dbu[i];
-                r2[j] += c * ddbu[i];
-            }
-        }
-        [r0, r1, r2]
+        contract(u, |j, i| self.cp[j][i])
     }
 
     /// The columns contracted along `v`: value, d/dv and d²/dv² of each column `i` (the
     /// transpose of [`BezierPatch::rows_at`], for lines `v = const`).
     #[inline]
     pub(crate) fn cols_at(&self, v: f64) -> Rows {
-        let (bv, dbv, ddbv) = bernstein3(v);
-        let mut c0 = [Vector4::zeros(); 4];
-        let mut c1 = [Vector4::zeros(); 4];
-        let mut c2 = [Vector4::zeros(); 4];
-        for j in 0..4 {
-            for i in 0..4 {
-                let c = self.cp[j][i];
-                c0[i] += c * bv[j];
-                c1[i] += c * dbv[j];
-                c2[i] += c * ddbv[j];
-            }
-        }
-        [c0, c1, c2]
+        contract(v, |i, j| self.cp[j][i])
     }
 
     /// Point and derivatives at `v` from the rows of [`BezierPatch::rows_at`]`(u)`: those of
@@ -229,6 +205,24 @@ impl BezierPatch {
         let [a, a_run, a_held] = finish_first(&cols[0], &cols[1], u);
         rational_first(a, a_run, a_held)
     }
+}
+
+/// A control net contracted along one parameter at `x`: for each line `o` across it, the
+/// value and first and second derivatives along it, summed over `k` in order; `cp_at(o, k)`
+/// is the net's point `k` along the contracted parameter on line `o`.
+#[inline(always)]
+fn contract(x: f64, cp_at: impl Fn(usize, usize) -> Vector4) -> Rows {
+    let (b, db, ddb) = bernstein3(x);
+    let mut r = [[Vector4::zeros(); 4]; 3];
+    for o in 0..4 {
+        for k in 0..4 {
+            let c = cp_at(o, k);
+            r[0][o] += c * b[k];
+            r[1][o] += c * db[k];
+            r[2][o] += c * ddb[k];
+        }
+    }
+    r
 }
 
 /// Homogeneous value and derivatives at `x` of a patch contracted across a line (`rows`:
