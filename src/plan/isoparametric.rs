@@ -52,14 +52,11 @@ const CORNER_MATCH_REL: f64 = 1e-7;
 
 /// A surface with one parameter square, as the zig-zag sees it.
 pub trait ParamSurface {
-    fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs;
     fn subs(&self, u: f64, v: f64) -> Point3;
     /// Unit normal on the tool's side, taken from nearby where the surface is singular.
     fn normal(&self, u: f64, v: f64) -> Option<Vector3>;
     /// [`ParamSurface::subs`] and [`ParamSurface::normal`] from one evaluation.
     fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>);
-    /// [`ParamSurface::derivs`] and [`ParamSurface::normal`] from one evaluation.
-    fn derivs_normal(&self, u: f64, v: f64) -> (SurfaceDerivs, Option<Vector3>);
     /// Where this is, for error messages.
     fn label(&self) -> String;
     /// The iso-line along `dir` at across-parameter `w` (`at(dir, t, w)` for running `t`),
@@ -98,9 +95,6 @@ pub fn patch_views(model: &Model) -> Vec<PatchView<'_>> {
 }
 
 impl ParamSurface for PatchView<'_> {
-    fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
-        self.patch.derivs(self.surface, u, v)
-    }
     fn subs(&self, u: f64, v: f64) -> Point3 {
         self.patch.subs(self.surface, u, v)
     }
@@ -111,11 +105,6 @@ impl ParamSurface for PatchView<'_> {
     fn point_normal(&self, u: f64, v: f64) -> (Point3, Option<Vector3>) {
         let (p, n) = self.patch.point_normal(self.surface, u, v);
         (p, n.map(|n| n * self.side))
-    }
-    /// Derivatives and tool-side unit normal at `(u, v)`, from one evaluation.
-    fn derivs_normal(&self, u: f64, v: f64) -> (SurfaceDerivs, Option<Vector3>) {
-        let (d, n) = self.patch.derivs_normal(self.surface, u, v);
-        (d, n.map(|n| n * self.side))
     }
     fn side(&self) -> f64 {
         self.side
