@@ -6,7 +6,7 @@
 use crate::support;
 
 use support::{extruded_obj, obj_model, public_tsm};
-use tspath::geom::Point3;
+use tspath::geom::{Point3, Vector3};
 use tspath::machine::{self, Dialect, JobInfo, Units};
 use tspath::model::samples;
 use tspath::plan::isoplanar::{self, deform};
@@ -337,4 +337,202 @@ fn the_papers_axis_follows_the_area_weighted_facet_normal_on_the_five_axis_head(
         .filter(|mv| angle(mv) <= 5.0)
         .count();
     assert!(plain_close < close / 2, "{plain_close} vs {close}");
+}
+
+/// A roof (`ridge` 1) or a valley (−1): two planes `z = s·slope·(5 − |x − 5|)` (mm, `s` the
+/// sign; the valley raised to lie above z 0) meeting along Y at x 5, tagged infinitely sharp,
+/// 10 mm long. Every control point of a side lies on its plane, so the limit surface is
+/// exactly the two planes.
+fn creased(slope: f64, ridge: f64) -> Model {
+    let z = |x: f64| {
+        let up = slope * (5.0 - (x - 5.0f64).abs());
+        if ridge > 0.0 {
+            up
+        } else {
+            5.0 * slope - up
+        }
+    };
+    let profile: Vec<(f64, f64)> = [0.0, 2.5, 5.0, 7.5, 10.0]
+        .iter()
+        .map(|&x| (x, z(x)))
+        .collect();
+    let ny = 4;
+    let mut text = extruded_obj(&profile, ny, 2.5, false);
+    // The crease's vertices (index 2 of each row, numbered from 0 in the tags).
+    for k in 0..ny {
+        let (a, b) = (k * profile.len() + 2, (k + 1) * profile.len() + 2);
+        text += &format!("t crease 2/1/0 {a} {b} 10\n");
+    }
+    obj_model(&text, "creased.obj")
+}
+
+/// The roof of [`creased`] with slope 0.4: a convex crease turning the normal by
+/// 2·atan 0.4, 43.6°.
+fn roof() -> Model {
+    creased(0.4, 1.0)
+}
+
+/// Distance (mm) from `c` to the roof: to the nearer of its two half-planes, or to the
+/// ridge where the foot falls beyond a half-plane's edge.
+fn roof_distance(c: &Point3) -> f64 {
+    let k = (1.0f64 + 0.16).sqrt();
+    // Left half-plane 0.4x − z = 0 for x ≤ 5; right 0.4(10 − x) − z = 0 for x ≥ 5.
+    let to_ridge = ((c.x - 5.0).powi(2) + (c.z - 2.0).powi(2)).sqrt();
+    let left = {
+        let d = (0.4 * c.x - c.z) / k;
+        let foot_x = c.x - 0.4 * d / k;
+        if foot_x <= 5.0 {
+            d.abs()
+        } else {
+            to_ridge
+        }
+    };
+    let right = {
+        let d = (0.4 * (10.0 - c.x) - c.z) / k;
+        let foot_x = c.x + 0.4 * d / k;
+        if foot_x >= 5.0 {
+            d.abs()
+        } else {
+            to_ridge
+        }
+    };
+    left.min(right)
+}
+
+/// Issue 16: the ball centres that pivot about a convex crease belong to neither side's CL
+/// mesh; without a strip of them the CL surface had a gap `r × 43.6°` (0.38 mm) wide along
+/// the ridge, planes parallel to it fell into the gap, and the cut left 0.0314 mm on the
+/// ridge (h 0.01 mm, 1.5 % of the roof uncut). With the strip: its ball centres touch the
+/// ridge (a radius from it, none nearer the roof), and the cut keeps the scallop.
+#[test]
+fn a_convex_crease_gets_a_strip_of_pivoting_ball_centres_and_its_ridge_is_cut() {
+    let m = roof();
+    let o = opts(0.5, 0.01);
+    let r = o.tool_radius_mm;
+    let s = isoplanar::slices(&m, &o, &mut |_| true).unwrap();
+    assert_eq!(s.mesh.strips.len(), 1, "one strip along the ridge");
+    let turn = 2.0 * 0.4f64.atan();
+    let mut seen = 0;
+    let mut widest: f64 = 0.0;
+    for v in s.mesh.vertices.iter().flatten() {
+        if s.mesh.strip(v.patch).is_none() {
+            continue;
+        }
+        seen += 1;
+        // Contact on the ridge, the centre a radius from it and from the roof.
+        assert!(
+            (v.cc.x - 5.0).abs() < 1e-9 && (v.cc.z - 2.0).abs() < 1e-9,
+            "{:?}",
+            v.cc
+        );
+        assert!(((v.cl - v.cc).norm() - r).abs() < 1e-12);
+        let d = roof_distance(&v.cl);
+        assert!((d - r).abs() < 1e-9, "a strip centre {d} mm from the roof");
+        // The turn from the first side's normal (the strip's `a`), as its parameter says.
+        let [left, right] = [-0.4, 0.4].map(|x| Vector3::new(x, 0.0, 1.0).normalize());
+        let from_a = if (s.mesh.strips[0].a == 0) == (s.mesh.vertex(0).cc.x < 5.0) {
+            left
+        } else {
+            right
+        };
+        let turned = v.normal.cross(&from_a).norm().atan2(v.normal.dot(&from_a));
+        assert!(
+            (turned - v.uv[1] * turn).abs() < 1e-9,
+            "{turned} at k {}",
+            v.uv[1]
+        );
+        widest = widest.max(turned);
+    }
+    assert!(
+        seen > 10 && (widest - turn).abs() < 1e-9,
+        "{seen} strip vertices"
+    );
+    // Planes parallel to the ridge (0°): the cut keeps the scallop on the ridge too.
+    let (planned, v) = plan_and_verify(&m, &o);
+    let rep = planned.report(&o);
+    println!(
+        "roof at 0°: {} planes, {:.0} mm; simulated max {:.5} mm at {:?} (bound {:.5}), uncut {:.4} %, {} gouges",
+        rep.planes.unwrap(),
+        rep.length_mm,
+        v.max_scallop_mm,
+        v.max_scallop_at_mm,
+        v.error_bound_mm,
+        100.0 * v.uncut_fraction,
+        v.gouge_count
+    );
+    assert!(v.error_bound_mm <= 0.25 * o.scallop_mm, "unproven");
+    assert!(
+        v.max_scallop_mm <= o.scallop_mm,
+        "{} mm left",
+        v.max_scallop_mm
+    );
+    assert_eq!(v.uncut_fraction, 0.0);
+    assert_eq!(v.gouge_count, 0);
+}
+
+/// Issue 16: at a concave crease the two sides' offsets cross; the planes' passes ran on past
+/// the groove to each side's edge, their balls there were lifted clear of the other side
+/// (each then touching one side only) and the straight moves to them rose over the whole
+/// chord. A valley of 16° (r 0.5, h 0.01 mm): planes across it (90°) left 0.0267 mm, 58 %
+/// of the surface over h; at 30°, 0.0181 mm. Now each pass ends where its ball centres reach
+/// the groove, and a pass runs along the groove (the ball there touching both sides leaves
+/// r (1 / cos 8° − 1) = 0.0049 mm on the crease).
+#[test]
+fn passes_end_at_a_concave_creases_groove_and_a_pass_runs_along_it() {
+    let m = creased(8f64.to_radians().tan(), -1.0);
+    for angle in [0.0, 90.0, 30.0] {
+        let mut o = opts(0.5, 0.01);
+        o.slice_angle_deg = angle;
+        let s = isoplanar::slices(&m, &o, &mut |_| true).unwrap();
+        assert_eq!(
+            s.mesh.strips.iter().map(|s| s.convex).collect::<Vec<_>>(),
+            vec![false],
+            "one concave crease"
+        );
+        let (planned, v) = plan_and_verify(&m, &o);
+        let rep = planned.report(&o);
+        println!(
+            "valley at {angle}°: {} planes, {} pieces, {} retractions, {:.0} mm; simulated max {:.5} mm at {:?} (bound {:.5}), uncut {:.4} %, {} gouges",
+            rep.planes.unwrap(),
+            rep.segments.unwrap(),
+            rep.retractions,
+            rep.length_mm,
+            v.max_scallop_mm,
+            v.max_scallop_at_mm,
+            v.error_bound_mm,
+            100.0 * v.uncut_fraction,
+            v.gouge_count
+        );
+        assert!(
+            v.error_bound_mm <= 0.25 * o.scallop_mm,
+            "{angle}°: unproven"
+        );
+        assert!(
+            v.max_scallop_mm <= o.scallop_mm,
+            "{angle}°: {} mm",
+            v.max_scallop_mm
+        );
+        assert_eq!(v.uncut_fraction, 0.0, "{angle}°");
+        assert_eq!(v.gouge_count, 0, "{angle}°");
+        // The groove's pass: moves whose ball touches the crease's both sides, a radius
+        // from each plane, over the crease's length (10 mm).
+        let k = (1.0f64 + 8f64.to_radians().tan().powi(2)).sqrt();
+        let in_groove: Vec<f64> = planned
+            .toolpath
+            .moves
+            .iter()
+            .filter(|mv| mv.kind.on_surface())
+            .filter(|mv| {
+                let c = mv.cl_point;
+                let t = 8f64.to_radians().tan();
+                let left = (c.z - t * (5.0 - c.x)) / k;
+                let right = (c.z - t * (c.x - 5.0)) / k;
+                (left - 0.5).abs() < 1e-3 && (right - 0.5).abs() < 1e-3
+            })
+            .map(|mv| mv.cl_point.y)
+            .collect();
+        let span = in_groove.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - in_groove.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(span > 9.9, "{angle}°: the groove cut over {span} mm");
+    }
 }

@@ -10,12 +10,25 @@
 //! centre that would cut into the surface until it touches without cutting in (the same
 //! lifting every strategy gets): no CL point of the plan lies closer than a radius.
 //!
+//! Where two patches meet at a convex crease (their normals differ along the seam), the ball
+//! centres that touch the seam's edge pivot about it from one patch's normal to the other's;
+//! they belong to neither patch's grid, so the mesh gets a pivot strip there ([`Strip`]):
+//! rows of ball centres `p + r·n(k)` over the seam points `p`, `n(k)` turning from one
+//! normal to the other in steps the chordal tolerance allows. Without it the CL surface has a
+//! gap `r` times the crease's angle wide along the seam, and a plane running along the gap
+//! cuts neither side (Bike.tsm at 0°: 0.0137 mm left beside its middle crease, h 0.01 mm).
+//! At a concave crease the two sides' offsets cross instead, and the ball that cleans the
+//! groove touches both sides: the mesh keeps one row of ball centres there, pivoted half-way
+//! (`k` ½, a radius from the crease, so cutting into both sides), not meshed, for a pass
+//! along the groove; the pipeline lifts those balls until they touch without cutting in.
+//!
 //! Owns: the mesh and its vertices' patch parameters. Must not: deform or slice it.
 
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
 use crate::model::Model;
 use crate::plan::stepover;
+use crate::surface::diffgeom::unit_normal;
 use crate::surface::{DiffGeom, SurfaceDerivs};
 
 /// The grid cells per unit parameter that `u` and `v` of `patch` ask for, per interval
@@ -114,8 +127,10 @@ fn grid_lines(d: &[Vec<f64>; 2], scale: f64) -> [Vec<f64>; 2] {
 /// A vertex of the CL mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClVertex {
+    /// Its layout patch, or past the layout's patches its pivot strip (see
+    /// [`ClMesh::strip`]).
     pub patch: u32,
-    /// Patch parameters of its contact point.
+    /// Patch parameters of its contact point (a strip's: along the seam, and the turn).
     pub uv: [f64; 2],
     /// Contact point on the surface (mm).
     pub cc: Point3,
@@ -126,13 +141,135 @@ pub struct ClVertex {
 }
 
 /// The mesh: vertices (`None` at singular points, where the surface has no normal) and
-/// triangles, each within one patch, counter-clockwise in `(u, v)`.
+/// triangles, each within one patch or strip, counter-clockwise in `(u, v)`.
 #[derive(Debug, Clone)]
 pub struct ClMesh {
     pub vertices: Vec<Option<ClVertex>>,
     pub triangles: Vec<[u32; 3]>,
-    /// Per patch: its first vertex and its grid's cells `(nu, nv)`.
+    /// Per layout patch, then per pivot strip: its first vertex and its grid's cells
+    /// `(nu, nv)`.
     pub patches: Vec<(u32, [usize; 2])>,
+    /// The pivot strips at convex creases, numbered after the layout's patches.
+    pub strips: Vec<Strip>,
+}
+
+/// Ball centres pivoting about a crease: where patch `a`'s side `side` lies on patch `b` and
+/// the normals on either side differ, the strip's parameters `(s, k)` are the parameter `s`
+/// along `a`'s side and the turn `k` from `a`'s normal (0) to `b`'s (1); its contact point is
+/// the seam's point at `s` whatever `k`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Strip {
+    /// Convex (the strip is meshed, its rows turning from one side's normal to the other's),
+    /// or concave (its one row, at `k` ½, is the groove's pass and is not meshed).
+    pub convex: bool,
+    pub a: u32,
+    /// Side of `a` (0: `v = 0`, 1: `u = 1`, 2: `v = 1`, 3: `u = 0`).
+    pub side: u8,
+    pub b: u32,
+    /// The side of `b` the seam lies on.
+    pub side_b: u8,
+    /// Its columns, in increasing `s`: `s`, and `b`'s patch parameters at the same point
+    /// (between columns taken linearly).
+    pub cols: Vec<(f64, [f64; 2])>,
+}
+
+/// Patch parameters of side `side` (0: `v = 0`, 1: `u = 1`, 2: `v = 1`, 3: `u = 0`) at `t`.
+pub fn side_uv(side: u8, t: f64) -> [f64; 2] {
+    match side {
+        0 => [t, 0.0],
+        1 => [1.0, t],
+        2 => [t, 1.0],
+        _ => [0.0, t],
+    }
+}
+
+/// Of first derivatives `su`, `sv` on side `side`: the one along the side, and the one into
+/// the patch from it.
+fn along_into(side: u8, su: Vector3, sv: Vector3) -> (Vector3, Vector3) {
+    match side {
+        0 => (su, sv),
+        1 => (sv, -su),
+        2 => (su, -sv),
+        _ => (sv, su),
+    }
+}
+
+/// The unit normal a turn `k` (0 to 1) of the way from unit normal `na` to `nb` about their
+/// common perpendicular (exactly `na` at 0 and `nb` at 1).
+pub fn pivot_normal(na: &Vector3, nb: &Vector3, k: f64) -> Vector3 {
+    if k <= 0.0 {
+        return *na;
+    }
+    if k >= 1.0 {
+        return *nb;
+    }
+    let theta = na.cross(nb).norm().atan2(na.dot(nb));
+    let s = theta.sin();
+    if !(s > 0.0) {
+        return (*na * (1.0 - k) + *nb * k)
+            .try_normalize(0.0)
+            .unwrap_or(*na);
+    }
+    (*na * ((1.0 - k) * theta).sin() + *nb * (k * theta).sin()) / s
+}
+
+/// The parameter along side `side` of patch parameters `uv`.
+pub fn along_side(side: u8, uv: [f64; 2]) -> f64 {
+    if side % 2 == 0 {
+        uv[0]
+    } else {
+        uv[1]
+    }
+}
+
+impl Strip {
+    /// The seam's point and the tool-side unit normal at strip parameters `[s, k]` (`s`
+    /// held within the columns, `k` within 0 to 1); `None` where either patch has no
+    /// normal.
+    pub fn at(&self, model: &Model, sk: [f64; 2]) -> Option<(Point3, Vector3)> {
+        let (p, na, nb) = self.ends(model, sk[0])?;
+        Some((p, pivot_normal(&na, &nb, sk[1])))
+    }
+
+    /// The seam's point at `s` (held within the columns) and the tool-side unit normals of
+    /// `a` and of `b` there.
+    pub fn ends(&self, model: &Model, s: f64) -> Option<(Point3, Vector3, Vector3)> {
+        let n = self.cols.len();
+        let s = s.clamp(self.cols[0].0, self.cols[n - 1].0);
+        let i = self.cols.partition_point(|c| c.0 <= s).clamp(1, n - 1);
+        let ((s0, b0), (s1, b1)) = (self.cols[i - 1], self.cols[i]);
+        let f = if s1 > s0 { (s - s0) / (s1 - s0) } else { 0.0 };
+        let uvb = [b0[0] + f * (b1[0] - b0[0]), b0[1] + f * (b1[1] - b0[1])];
+        let patches = &model.layout.patches;
+        let uva = side_uv(self.side, s);
+        let (p, na) = patches[self.a as usize].point_normal(&model.surface, uva[0], uva[1]);
+        let nb = patches[self.b as usize].normal(&model.surface, uvb[0], uvb[1])?;
+        let side = model.tool_side();
+        Some((p, na? * side, nb * side))
+    }
+
+    /// The same seam seen from `b`: its columns along `b`'s side, in increasing order.
+    pub fn reversed(&self) -> Strip {
+        let mut cols: Vec<(f64, [f64; 2])> = self
+            .cols
+            .iter()
+            .map(|&(s, uv_b)| (along_side(self.side_b, uv_b), side_uv(self.side, s)))
+            .collect();
+        cols.sort_by(|x, y| x.0.total_cmp(&y.0));
+        Strip {
+            convex: self.convex,
+            a: self.b,
+            side: self.side_b,
+            b: self.a,
+            side_b: self.side,
+            cols,
+        }
+    }
+
+    /// Patch `a`'s parameters of the contact point at strip parameter `s`.
+    pub fn uv_on_a(&self, s: f64) -> [f64; 2] {
+        side_uv(self.side, s)
+    }
 }
 
 /// Fewest and most grid cells along a patch side.
@@ -142,10 +279,156 @@ const MAX_CELLS: usize = 256;
 const SIZE_SAMPLES: usize = 33;
 /// Most vertices of the whole mesh: beyond it the grids are coarsened (evenly).
 const MAX_VERTICES: usize = 2_000_000;
+/// Most rows of a pivot strip (a crease of 180° at the chordal steps of a coarse tolerance).
+const MAX_PIVOT_ROWS: usize = 64;
+/// Newton steps finding the point of a side nearest a point of another.
+const PROJECT_STEPS: usize = 16;
+/// A Newton step below this (in a side's parameter) ends the search.
+const PROJECT_PARAM_TOL: f64 = 1e-13;
 
 /// Takes a vertex's index and the surface's derivatives at its contact point (patch
 /// parameters) as [`ClMesh::new_with`] makes it.
 pub type VertexVisit<'a> = &'a mut dyn FnMut(usize, &SurfaceDerivs);
+
+/// Two triangles per cell of an `nu` × `nv` grid of vertices numbered row by row from `first`.
+fn grid_triangles(first: u32, nu: usize, nv: usize, triangles: &mut Vec<[u32; 3]>) {
+    let id = |i: usize, j: usize| first + (j * (nu + 1) + i) as u32;
+    for j in 0..nv {
+        for i in 0..nu {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+}
+
+/// The parameter of the point of side `side` of `patch` nearest `p`, by Newton steps from
+/// `t0`.
+fn nearest_on_side(model: &Model, patch: u32, side: u8, p: &Point3, t0: f64) -> f64 {
+    let patch = &model.layout.patches[patch as usize];
+    let mut t = t0;
+    for _ in 0..PROJECT_STEPS {
+        let uv = side_uv(side, t);
+        let (q, su, sv) = patch.first_derivs(&model.surface, uv[0], uv[1]);
+        let (along, _) = along_into(side, su, sv);
+        let g = along.norm_squared();
+        if !(g > 0.0) {
+            break;
+        }
+        let next = (t - (q - p).dot(&along) / g).clamp(0.0, 1.0);
+        let done = (next - t).abs() < PROJECT_PARAM_TOL;
+        t = next;
+        if done {
+            break;
+        }
+    }
+    t
+}
+
+/// A column of a strip as it is found: the parameter along the first patch's side, the
+/// other patch's parameters there, the normals' turn (radians) and its kind.
+#[derive(Debug, Clone, Copy)]
+struct Column {
+    s: f64,
+    uv_b: [f64; 2],
+    turn: f64,
+    convex: bool,
+}
+
+/// The pivot strips of `model` for a ball of radius `r` over patch grids `breaks`, with their
+/// rows: along each side two patches share, its columns at the grid lines of the first
+/// patch's side where the seam is a crease (the normals on either side, seen from the tool,
+/// turn by more than the chordal tolerance over `r`), convex (each normal leaning away from
+/// the other patch) or concave (each towards it), in runs of at least two of one kind; rows
+/// of a convex strip every turn the chordal tolerance allows (and the longest cell side), at
+/// least one; a concave strip's none (its one row of vertices is not meshed).
+fn pivot_strips(
+    model: &Model,
+    breaks: &[[Vec<f64>; 2]],
+    r: f64,
+    chordal_mm: f64,
+    max_cell_mm: f64,
+) -> Vec<(Strip, usize)> {
+    let views = crate::plan::isoparametric::patch_views(model);
+    let shared = crate::plan::isfc::shared_sides(model, &views);
+    let (surface, patches, side) = (&model.surface, &model.layout.patches, model.tool_side());
+    let min_turn = chordal_mm / r;
+    let turn_step = (2.0 * (1.0 - chordal_mm / r).clamp(-1.0, 1.0).acos()).min(max_cell_mm / r);
+    let mut out = Vec::new();
+    for (a, sa, b, sb) in shared {
+        // Where b's side runs, for the nearest point's first guess: its grid's points.
+        let lines = |p: u32, s: u8| &breaks[p as usize][if s % 2 == 0 { 0 } else { 1 }];
+        let guesses: Vec<(f64, Point3)> = lines(b, sb)
+            .iter()
+            .map(|&t| {
+                let uv = side_uv(sb, t);
+                (t, patches[b as usize].subs(surface, uv[0], uv[1]))
+            })
+            .collect();
+        let column = |t: f64| -> Option<Column> {
+            let uva = side_uv(sa, t);
+            let (p, su, sv) = patches[a as usize].first_derivs(surface, uva[0], uva[1]);
+            let na = unit_normal(&su, &sv)? * side;
+            let (_, into_a) = along_into(sa, su, sv);
+            let t0 = guesses
+                .iter()
+                .min_by(|x, y| (x.1 - p).norm().total_cmp(&(y.1 - p).norm()))?
+                .0;
+            let uvb = side_uv(sb, nearest_on_side(model, b, sb, &p, t0));
+            let (q, su_b, sv_b) = patches[b as usize].first_derivs(surface, uvb[0], uvb[1]);
+            if (q - p).norm() > chordal_mm {
+                return None;
+            }
+            let nb = unit_normal(&su_b, &sv_b)? * side;
+            let (_, into_b) = along_into(sb, su_b, sv_b);
+            let turn = na.cross(&nb).norm().atan2(na.dot(&nb));
+            // Convex: each patch's normal leans away from the other patch; concave: towards.
+            let (lean_a, lean_b) = (nb.dot(&into_a), na.dot(&into_b));
+            let convex = lean_a < 0.0 && lean_b < 0.0;
+            let concave = lean_a > 0.0 && lean_b > 0.0;
+            (turn > min_turn && (convex || concave)).then_some(Column {
+                s: t,
+                uv_b: uvb,
+                turn,
+                convex,
+            })
+        };
+        let cols: Vec<Option<Column>> = lines(a, sa).iter().map(|&t| column(t)).collect();
+        // Runs of columns of one kind.
+        let mut runs: Vec<Vec<Column>> = Vec::new();
+        let mut run: Vec<Column> = Vec::new();
+        for c in cols.iter().chain([&None]) {
+            match c {
+                Some(c) if run.last().is_none_or(|l| l.convex == c.convex) => run.push(*c),
+                _ => {
+                    runs.push(std::mem::take(&mut run));
+                    run.extend(*c);
+                }
+            }
+        }
+        for run in runs.into_iter().filter(|run| run.len() >= 2) {
+            let convex = run[0].convex;
+            let widest = run.iter().map(|c| c.turn).fold(0.0, f64::max);
+            let rows = if convex {
+                ((widest / turn_step).ceil() as usize).clamp(1, MAX_PIVOT_ROWS)
+            } else {
+                0
+            };
+            out.push((
+                Strip {
+                    convex,
+                    a,
+                    side: sa,
+                    b,
+                    side_b: sb,
+                    cols: run.iter().map(|c| (c.s, c.uv_b)).collect(),
+                },
+                rows,
+            ));
+        }
+    }
+    out
+}
 
 impl ClMesh {
     /// The CL mesh of `model` for a ball of radius `r` (mm) within chordal tolerance
@@ -154,8 +437,9 @@ impl ClMesh {
         Self::build(model, r, chordal_mm, max_cell_mm, None)
     }
 
-    /// [`ClMesh::new`], handing each vertex's index and the surface's derivatives there
-    /// (in the patch's parameters) to `each` as the vertex is made: one evaluation serves
+    /// [`ClMesh::new`], handing each patch grid vertex's index and the surface's derivatives
+    /// there (in the patch's parameters) to `each` as the vertex is made (the pivot strips'
+    /// vertices, made last, are not handed over): one evaluation serves
     /// the mesh and a caller that needs the curvature at every vertex. The mesh is the
     /// same bit for bit (the point and first derivatives equal those evaluated alone).
     pub fn new_with(
@@ -225,14 +509,30 @@ impl ClMesh {
                     }));
                 }
             }
-            let id = |i: usize, j: usize| first + (j * (nu + 1) + i) as u32;
-            for j in 0..nv {
-                for i in 0..nu {
-                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                    triangles.push([a, b, c]);
-                    triangles.push([a, c, d]);
+            grid_triangles(first, nu, nv, &mut triangles);
+        }
+        // Pivot strips along the convex creases, after the patches.
+        let mut strips = Vec::new();
+        for (strip, rows) in pivot_strips(model, &breaks, r, chordal_mm, max_cell_mm) {
+            let first = vertices.len() as u32;
+            let pi = (layout.patches.len() + strips.len()) as u32;
+            let (nu, nv) = (strip.cols.len() - 1, rows);
+            patches.push((first, [nu, nv]));
+            for j in 0..=nv {
+                let k = if nv == 0 { 0.5 } else { j as f64 / nv as f64 };
+                for &(s, _) in &strip.cols {
+                    let uv = [s, k];
+                    vertices.push(strip.at(model, uv).map(|(cc, normal)| ClVertex {
+                        patch: pi,
+                        uv,
+                        cc,
+                        normal,
+                        cl: cc + normal * r,
+                    }));
                 }
             }
+            grid_triangles(first, nu, nv, &mut triangles);
+            strips.push(strip);
         }
         // Triangles through a singular vertex are dropped (their neighbours' slices end there).
         triangles.retain(|t| t.iter().all(|&v| vertices[v as usize].is_some()));
@@ -246,7 +546,14 @@ impl ClMesh {
             vertices,
             triangles,
             patches,
+            strips,
         })
+    }
+
+    /// The pivot strip that `patch` (a vertex's or a slice point's) numbers, if it is one.
+    pub fn strip(&self, patch: u32) -> Option<&Strip> {
+        let first = self.patches.len() - self.strips.len();
+        (patch as usize).checked_sub(first).map(|k| &self.strips[k])
     }
 
     /// Vertex `i` (which the triangles only name where it exists).
@@ -271,6 +578,27 @@ mod tests {
                 c * (hi.min(b) - lo.max(a)).max(0.0)
             })
             .sum()
+    }
+
+    #[test]
+    fn the_pivot_normal_turns_evenly_from_one_normal_to_the_other() {
+        let na = Vector3::new(-0.4, 0.0, 1.0).normalize();
+        let nb = Vector3::new(0.7, -0.2, 0.5).normalize();
+        let turn = na.cross(&nb).norm().atan2(na.dot(&nb));
+        assert_eq!(pivot_normal(&na, &nb, 0.0), na);
+        assert_eq!(pivot_normal(&na, &nb, 1.0), nb);
+        for i in 1..10 {
+            let k = i as f64 / 10.0;
+            let n = pivot_normal(&na, &nb, k);
+            assert!((n.norm() - 1.0).abs() < 1e-12);
+            // In the plane of the two, k of the way round from one and 1 − k from the other.
+            assert!(n.dot(&na.cross(&nb)).abs() < 1e-12);
+            let from = |m: &Vector3| n.cross(m).norm().atan2(n.dot(m));
+            assert!((from(&na) - k * turn).abs() < 1e-12);
+            assert!((from(&nb) - (1.0 - k) * turn).abs() < 1e-12);
+        }
+        // Equal normals stay put.
+        assert!((pivot_normal(&na, &na, 0.5) - na).norm() < 1e-15);
     }
 
     #[test]

@@ -23,6 +23,7 @@
 //! Owns: the slices and their order. Must not: choose tool axes or route air moves.
 
 pub mod clmesh;
+pub mod crease;
 pub mod deform;
 pub mod slice;
 
@@ -189,8 +190,9 @@ pub fn side_scallop(opts: &PlanOptions) -> f64 {
 }
 
 /// Derivatives and tool-side fundamental forms of `model` at patch `patch`, `uv`.
+/// `None` where it has no normal, and for a pivot strip's `patch` (beyond the layout's).
 fn geometry(model: &Model, patch: u32, uv: [f64; 2]) -> Option<(SurfaceDerivs, DiffGeom)> {
-    let p = &model.layout.patches[patch as usize];
+    let p = model.layout.patches.get(patch as usize)?;
     let d = p.derivs(&model.surface, uv[0], uv[1]);
     let g = tool_side_geom(model, &d)?;
     Some((d, g))
@@ -340,6 +342,11 @@ pub fn slices(
                         continue;
                     }
                     let (va, vb) = (mesh.vertex(a), mesh.vertex(b));
+                    // A pivot strip's edges turn about one contact point, where the balls
+                    // leave no cusp between them: the planes need not crowd there.
+                    if mesh.strip(va.patch).is_some() {
+                        continue;
+                    }
                     let (xa, xb) = (coords[a as usize][0], coords[b as usize][0]);
                     let n = (va.normal + vb.normal)
                         .try_normalize(1e-12)
@@ -406,7 +413,7 @@ pub fn slices(
     passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
     let mut checks: Vec<PassChecks> = passes
         .iter()
-        .map(|p| PassChecks::new(model, opts, &frame, p))
+        .map(|p| PassChecks::new(model, &mesh, opts, &frame, p))
         .collect();
     let mut added_planes = 0;
     let mut gap = step;
@@ -440,7 +447,10 @@ pub fn slices(
             if !kept.is_empty() {
                 added_planes += 1;
             }
-            checks.extend(kept.iter().map(|p| PassChecks::new(model, opts, &frame, p)));
+            checks.extend(
+                kept.iter()
+                    .map(|p| PassChecks::new(model, &mesh, opts, &frame, p)),
+            );
             passes.extend(kept);
         }
         // Sorted by plane, the checks kept beside their passes (a stable sort, as before).
@@ -456,6 +466,7 @@ pub fn slices(
     // Last, a pass along the surface's free boundary: where a boundary runs slanted to the
     // planes, or curves, the last pass of a plane ends short of it.
     passes.extend(boundary_passes(model, &mesh));
+    passes.extend(crease::groove_passes(&mesh));
     let max_ratio = deformation.ratio.iter().copied().fold(1.0, f64::max);
     let stats = IsoplanarStats {
         planes,
@@ -552,7 +563,8 @@ fn boundary_passes(model: &Model, mesh: &ClMesh) -> Vec<Pass> {
     let views = super::isoparametric::patch_views(model);
     let shared = super::isfc::shared_sides(model, &views);
     let mut passes: Vec<Pass> = Vec::new();
-    for (p, &(first, [nu, nv])) in mesh.patches.iter().enumerate() {
+    let layout_patches = &mesh.patches[..mesh.patches.len() - mesh.strips.len()];
+    for (p, &(first, [nu, nv])) in layout_patches.iter().enumerate() {
         for side in 0..4u8 {
             if shared.iter().any(|&(a, sa, b, sb)| {
                 (a as usize, sa) == (p, side) || (b as usize, sb) == (p, side)
@@ -734,9 +746,20 @@ fn skippable(a: &SlicePoint, b: &SlicePoint, m: &SlicePoint, tol: f64) -> bool {
     dist_to_segment(&uv(m), &ua, &ub) * speed <= tol
 }
 
-/// Joins open passes of one plane whose ends meet at a patch seam (within `tol` mm), into
-/// longer passes (a pass whose ends meet becomes closed).
+/// Joins open passes of one plane whose ends meet at a patch seam (within `tol` mm; at a
+/// concave crease, within `tol` of the two sides' offsets there), into longer passes (a pass
+/// whose ends meet becomes closed).
 fn join_at_seams(mesh: &ClMesh, mut passes: Vec<Pass>, tol: f64) -> Vec<Pass> {
+    let concave = |p: u32, q: u32| {
+        mesh.strips
+            .iter()
+            .any(|s| !s.convex && ((s.a, s.b) == (p, q) || (s.a, s.b) == (q, p)))
+    };
+    // A slice point's offset from its contact point (on the mesh).
+    let offset = |p: &SlicePoint| {
+        let (a, b) = (mesh.vertex(p.hit.a).cc, mesh.vertex(p.hit.b).cc);
+        p.mesh_cl - (a + (b - a) * p.hit.t)
+    };
     loop {
         let mut best: Option<(f64, usize, bool, usize, bool)> = None;
         for i in 0..passes.len() {
@@ -769,7 +792,12 @@ fn join_at_seams(mesh: &ClMesh, mut passes: Vec<Pass>, tol: f64) -> Vec<Pass> {
                     if i != j && a.patch == b.patch {
                         continue;
                     }
-                    let d = (a.mesh_cl - b.mesh_cl).norm();
+                    // Across a concave crease the two sides' offsets end apart by the turn of
+                    // the normal (the draft ends each at the groove).
+                    let mut d = (a.mesh_cl - b.mesh_cl).norm();
+                    if d > tol && concave(a.patch, b.patch) {
+                        d -= (offset(&a) - offset(&b)).norm();
+                    }
                     if d <= tol && best.is_none_or(|x| d < x.0) {
                         best = Some((d, i, ei, j, ej));
                     }
@@ -798,14 +826,17 @@ fn join_at_seams(mesh: &ClMesh, mut passes: Vec<Pass>, tol: f64) -> Vec<Pass> {
 
 /// Where a pass is checked for the cusp beside it: every point a quarter spacing on from the
 /// last checked, and the last; each with its contact point, CL point, the curvature across
-/// the feed and the feed direction; and the contact polyline through them.
+/// the feed and the feed direction; and the contact polyline through them. A pivot strip's
+/// points are not checked (their balls all touch the crease, which has no curvature across)
+/// but their contact points (on the crease) are on the polyline, for the neighbours'
+/// checks.
 struct PassChecks {
     points: Vec<(Point3, Point3, f64, Vector3)>,
     segments: Vec<(Point3, Point3)>,
 }
 
 impl PassChecks {
-    fn new(model: &Model, opts: &PlanOptions, frame: &Frame, p: &Pass) -> Self {
+    fn new(model: &Model, mesh: &ClMesh, opts: &PlanOptions, frame: &Frame, p: &Pass) -> Self {
         let r = opts.tool_radius_mm;
         let h = opts.scallop_mm * (1.0 - CHORD_SCALLOP_SHARE);
         let mut out = PassChecks {
@@ -818,6 +849,16 @@ impl PassChecks {
         for (i, s) in p.points.iter().enumerate() {
             // Every point a quarter spacing on from the last checked, and the last.
             if last.is_some_and(|l| (s.mesh_cl - l).norm() < every) && i + 1 < n {
+                continue;
+            }
+            if mesh.strip(s.patch).is_some() {
+                let (a, b) = (mesh.vertex(s.hit.a).cc, mesh.vertex(s.hit.b).cc);
+                let cc = a + (b - a) * s.hit.t;
+                if let Some(a) = last_cc {
+                    out.segments.push((a, cc));
+                }
+                last = Some(s.mesh_cl);
+                last_cc = Some(cc);
                 continue;
             }
             let Some((d, g)) = geometry(model, s.patch, s.uv) else {
@@ -1064,6 +1105,7 @@ pub fn draft(
     let mut out = DraftBuilder::new(model, opts);
     let ctx = Emit {
         model,
+        mesh: &s.mesh,
         views: super::isoparametric::patch_views(model),
         r,
         chordal: opts.chordal_mm,
@@ -1072,6 +1114,7 @@ pub fn draft(
         spacing,
         h: side_scallop(opts),
     };
+    let creases = crease::Creases::new(&s.mesh);
     // Zig-zag: plane by plane, the nearest remaining piece of the plane next.
     let mut remaining: Vec<Option<&Pass>> = s.passes.iter().map(Some).collect();
     let mut at: Option<SurfacePoint> = None;
@@ -1143,6 +1186,7 @@ pub fn draft(
             }
             pts.push(pts[0]);
         }
+        let pts = creases.trim(model, pts, r);
         let points = ctx.refine(&pts)?;
         let Some(start) = points.first().copied() else {
             continue;
@@ -1155,10 +1199,10 @@ pub fn draft(
             if at.is_some() {
                 stats.retractions += 1;
             }
-            out.approach(&start, line, ctx.footprint(&points, 0));
+            out.approach(&ctx.on_layout(&start), line, ctx.footprint(&points, 0));
         }
         for i in 1..points.len() {
-            out.feed(&points[i], line, ctx.footprint(&points, i));
+            out.feed(&ctx.on_layout(&points[i]), line, ctx.footprint(&points, i));
         }
         at = points.last().copied();
         line += 1;
@@ -1205,6 +1249,8 @@ impl Curve {
 /// What placing moves needs.
 struct Emit<'a> {
     model: &'a Model,
+    /// The CL mesh, for its pivot strips.
+    mesh: &'a ClMesh,
     views: Vec<super::isoparametric::PatchView<'a>>,
     r: f64,
     chordal: f64,
@@ -1219,8 +1265,24 @@ struct Emit<'a> {
 }
 
 impl Emit<'_> {
-    /// The surface point of patch `patch` at `uv`.
+    /// The surface point of patch `patch` at `uv` (of a pivot strip: its contact point on
+    /// the crease and its turned normal).
     fn point(&self, patch: u32, uv: [f64; 2]) -> Result<SurfacePoint> {
+        if let Some(strip) = self.mesh.strip(patch) {
+            let (cc, normal) = strip.at(self.model, uv).ok_or_else(|| Error::Degenerate {
+                location: format!(
+                    "the crease between patches {} and {} at {:.6}",
+                    strip.a, strip.b, uv[0]
+                ),
+                message: "a patch has no tangent plane at the crease".into(),
+            })?;
+            return Ok(SurfacePoint {
+                patch,
+                uv: [uv[0].clamp(0.0, 1.0), uv[1].clamp(0.0, 1.0)],
+                cc,
+                normal,
+            });
+        }
         let (cc, normal) = super::isfc::point(&self.views[patch as usize], uv)?;
         Ok(SurfacePoint {
             patch,
@@ -1433,6 +1495,19 @@ impl Emit<'_> {
         off.norm() <= share * limit
     }
 
+    /// `p` as the pipeline takes it: a pivot strip's point as its contact point on the
+    /// strip's first patch, keeping its turned normal.
+    fn on_layout(&self, p: &SurfacePoint) -> SurfacePoint {
+        match self.mesh.strip(p.patch) {
+            Some(strip) => SurfacePoint {
+                patch: strip.a,
+                uv: strip.uv_on_a(p.uv[0]),
+                ..*p
+            },
+            None => *p,
+        }
+    }
+
     /// Whether the tool may go from `a` to `b` on the surface: the same patch, and close.
     fn can_link(&self, a: &SurfacePoint, b: &SurfacePoint) -> bool {
         a.patch == b.patch && (a.cc - b.cc).norm() <= LINK_SPACINGS * self.spacing
@@ -1450,17 +1525,20 @@ impl Emit<'_> {
         let mut curve = Curve::default();
         self.split(a, b, CHORD_DEPTH, &mut curve)?;
         for p in &curve.points {
-            out.link(p, line, Footprint::NONE);
+            out.link(&self.on_layout(p), line, Footprint::NONE);
         }
-        out.link(b, line, Footprint::NONE);
+        out.link(&self.on_layout(b), line, Footprint::NONE);
         Ok(())
     }
 
     /// The part of its patch point `i` of a pass stands for: half-way to its neighbours
     /// along the pass and half a side step across, as a rectangle of patch parameters.
+    /// A pivot strip's point stands for none (its contact is the crease, a line).
     fn footprint(&self, pts: &[SurfacePoint], i: usize) -> Footprint {
         let p = &pts[i];
-        let patch = &self.model.layout.patches[p.patch as usize];
+        let Some(patch) = self.model.layout.patches.get(p.patch as usize) else {
+            return Footprint::NONE;
+        };
         // First derivatives are all it takes (the same as those of `Patch::derivs`).
         let (_, su, sv) = patch.first_derivs(&self.model.surface, p.uv[0], p.uv[1]);
         let Some(normal) = crate::surface::diffgeom::unit_normal(&su, &sv) else {
