@@ -14,7 +14,9 @@
 //! predicted between neighbouring passes (eq. 5 from the contact points' distance and the
 //! curvature across) would exceed the scallop, a pass half-way between is added over that
 //! stretch (`added_planes`), up to [`MAX_SPLITS`] times; last, a pass runs along the free
-//! boundary, which the planes' last passes may end short of where it is slanted or curved.
+//! boundary, which the planes' last passes may end short of where it is slanted or curved,
+//! and one along each concave crease's groove ([`crease`]; convex creases are pivot strips
+//! of the CL mesh, see [`clmesh`]).
 //!
 //! The shared pipeline does the rest: tool axes (the project's collision-free axis, or the
 //! paper's normal with [`PlanOptions::lead_deg`]), lifting balls clear of creases and
