@@ -37,17 +37,23 @@ use crate::surface::{DiffGeom, SurfaceDerivs};
 /// most `max_cell_mm`; per interval the largest at its ends and theirs beside (a peak
 /// between samples is not missed by a sample's width), the largest across the other
 /// direction.
+///
+/// Also, per side and sample, whether the surface there is convex towards the tool with a
+/// radius under the ball's ([`TIGHT_CONVEX_RK`]) somewhere across the other direction (`side` is the tool's
+/// side, [`Model::tool_side`]): where [`refine_lines`] checks the cells.
 fn density(
     patch: &crate::layout::Patch,
     surface: &crate::surface::Surface,
+    side: f64,
     r: f64,
     chordal_mm: f64,
     max_cell_mm: f64,
-) -> [Vec<f64>; 2] {
+) -> ([Vec<f64>; 2], [Vec<bool>; 2]) {
     let n = SIZE_SAMPLES;
     let k = (n - 1) as f64;
     // Cells per unit parameter asked at each sample, the largest across the other side.
     let mut at = [vec![0.0f64; n], vec![0.0f64; n]];
+    let mut tight = [vec![false; n], vec![false; n]];
     for a in 0..n {
         for b in 0..n {
             let d = patch.derivs(surface, a as f64 / k, b as f64 / k);
@@ -71,9 +77,14 @@ fn density(
                 at[0][a] = at[0][a].max(d.su.norm() / seg);
                 at[1][b] = at[1][b].max(d.sv.norm() / seg);
             }
+            // Convex towards the tool: negative on the tool's side.
+            if (-side * k1).max(-side * k2) * r >= TIGHT_CONVEX_RK {
+                tight[0][a] = true;
+                tight[1][b] = true;
+            }
         }
     }
-    at.map(|side| {
+    let cells = at.map(|side| {
         (0..n - 1)
             .map(|i| {
                 side[i.saturating_sub(1)..(i + 3).min(n)]
@@ -82,7 +93,99 @@ fn density(
                     .fold(0.0, f64::max)
             })
             .collect()
-    })
+    });
+    (cells, tight)
+}
+
+/// `lines` (grid lines of one side of `patch`, the other side's parameter running across)
+/// with lines added where the CL mesh's cells would stray from the offset: between
+/// neighbouring lines near a sample flagged `tight`, the ball centre half-way (at
+/// [`CELL_PROBES`] + 1 places across) checked against the middle of the chord between the
+/// lines' ball centres, and the interval halved while it strays by more than the chordal
+/// tolerance (at most [`CELL_HALVINGS`] times). The density, sampled [`SIZE_SAMPLES`] times
+/// per side, misses an edge rounded to a sliver between samples: Bike.tsm's middle crease
+/// starts in a patch 0.013 mm wide whose ball centres swing 0.18 mm within its last half,
+/// which the grid took as two straight cells.
+#[allow(clippy::too_many_arguments)]
+fn refine_lines(
+    patch: &crate::layout::Patch,
+    surface: &crate::surface::Surface,
+    side: f64,
+    r: f64,
+    chordal_mm: f64,
+    dir: usize,
+    lines: &[f64],
+    tight: &[bool],
+) -> Vec<f64> {
+    let k = (tight.len() - 1) as f64;
+    let near_tight = |x0: f64, x1: f64| {
+        tight
+            .iter()
+            .enumerate()
+            .any(|(a, &t)| t && a as f64 / k >= x0 - 1.0 / k && a as f64 / k <= x1 + 1.0 / k)
+    };
+    // The ball centres along a line, at the places across where cells are checked.
+    let row = |x: f64| -> Vec<Option<Point3>> {
+        (0..=CELL_PROBES)
+            .map(|j| {
+                let w = j as f64 / CELL_PROBES as f64;
+                let (u, v) = if dir == 0 { (x, w) } else { (w, x) };
+                let (p, n) = patch.point_normal(surface, u, v);
+                n.map(|n| p + n * (side * r))
+            })
+            .collect()
+    };
+    type Row = Vec<Option<Point3>>;
+    // Adds the lines between `x0` and `x1` (their rows `r0`, `r1`) that bring the cells
+    // within the tolerance.
+    let split = |x0: f64, r0: &Row, x1: f64, r1: &Row, out: &mut Vec<f64>| {
+        fn go(
+            (x0, r0): (f64, &Row),
+            (x1, r1): (f64, &Row),
+            depth: usize,
+            row: &dyn Fn(f64) -> Row,
+            chordal_mm: f64,
+            out: &mut Vec<f64>,
+        ) {
+            if depth == 0 {
+                return;
+            }
+            let mid = 0.5 * (x0 + x1);
+            let rm = row(mid);
+            let strays = r0
+                .iter()
+                .zip(r1)
+                .zip(&rm)
+                .any(|((a, b), m)| match (a, b, m) {
+                    (Some(a), Some(b), Some(m)) => {
+                        (m - Point3::from(0.5 * (a.coords + b.coords))).norm() > chordal_mm
+                    }
+                    _ => false,
+                });
+            if !strays {
+                return;
+            }
+            go((x0, r0), (mid, &rm), depth - 1, row, chordal_mm, out);
+            out.push(mid);
+            go((mid, &rm), (x1, r1), depth - 1, row, chordal_mm, out);
+        }
+        go((x0, r0), (x1, r1), CELL_HALVINGS, &row, chordal_mm, out);
+    };
+    let mut out = vec![lines[0]];
+    let mut last: Option<(f64, Row)> = None;
+    for w in lines.windows(2) {
+        if near_tight(w[0], w[1]) {
+            let r0 = match last.take() {
+                Some((x, r)) if x == w[0] => r,
+                _ => row(w[0]),
+            };
+            let r1 = row(w[1]);
+            split(w[0], &r0, w[1], &r1, &mut out);
+            last = Some((w[1], r1));
+        }
+        out.push(w[1]);
+    }
+    out
 }
 
 /// Grid lines (patch parameters from 0 to 1) for [`density`] `d` times `scale`: per side
@@ -149,8 +252,11 @@ pub struct ClMesh {
     /// Per layout patch, then per pivot strip: its first vertex and its grid's cells
     /// `(nu, nv)`.
     pub patches: Vec<(u32, [usize; 2])>,
-    /// The pivot strips at convex creases, numbered after the layout's patches.
+    /// The pivot strips at creases, numbered after the layout's patches.
     pub strips: Vec<Strip>,
+    /// The sides two patches share, as [`crate::plan::isfc`] finds them:
+    /// `(patch, side, patch, side)`.
+    pub shared: Vec<(u32, u8, u32, u8)>,
 }
 
 /// Ball centres pivoting about a crease: where patch `a`'s side `side` lies on patch `b` and
@@ -277,8 +383,18 @@ const MIN_CELLS: usize = 2;
 const MAX_CELLS: usize = 256;
 /// Samples per side of a patch that place its grid lines.
 const SIZE_SAMPLES: usize = 33;
+/// `r κ` of a convex spot above which [`refine_lines`] checks the cells near it: a radius
+/// under the ball's, where the ball centres swing more than twice as fast as the contact
+/// point and the density's bound on the offset's sagitta no longer holds.
+const TIGHT_CONVEX_RK: f64 = 1.0;
+/// Places across a cell where [`refine_lines`] checks it, less one.
+const CELL_PROBES: usize = 8;
+/// Most halvings of a cell by [`refine_lines`].
+const CELL_HALVINGS: usize = 5;
 /// Most vertices of the whole mesh: beyond it the grids are coarsened (evenly).
 const MAX_VERTICES: usize = 2_000_000;
+/// Places along a shared side (less one) where it is first checked for a crease.
+const CREASE_PROBES: usize = 16;
 /// Most rows of a pivot strip (a crease of 180° at the chordal steps of a coarse tolerance).
 const MAX_PIVOT_ROWS: usize = 64;
 /// Newton steps finding the point of a side nearest a point of another.
@@ -344,18 +460,17 @@ struct Column {
 /// least one; a concave strip's none (its one row of vertices is not meshed).
 fn pivot_strips(
     model: &Model,
+    shared: &[(u32, u8, u32, u8)],
     breaks: &[[Vec<f64>; 2]],
     r: f64,
     chordal_mm: f64,
     max_cell_mm: f64,
 ) -> Vec<(Strip, usize)> {
-    let views = crate::plan::isoparametric::patch_views(model);
-    let shared = crate::plan::isfc::shared_sides(model, &views);
     let (surface, patches, side) = (&model.surface, &model.layout.patches, model.tool_side());
     let min_turn = chordal_mm / r;
     let turn_step = (2.0 * (1.0 - chordal_mm / r).clamp(-1.0, 1.0).acos()).min(max_cell_mm / r);
     let mut out = Vec::new();
-    for (a, sa, b, sb) in shared {
+    for &(a, sa, b, sb) in shared {
         // Where b's side runs, for the nearest point's first guess: its grid's points.
         let lines = |p: u32, s: u8| &breaks[p as usize][if s % 2 == 0 { 0 } else { 1 }];
         let guesses: Vec<(f64, Point3)> = lines(b, sb)
@@ -365,7 +480,8 @@ fn pivot_strips(
                 (t, patches[b as usize].subs(surface, uv[0], uv[1]))
             })
             .collect();
-        let column = |t: f64| -> Option<Column> {
+        // The column at `t` whatever its turn, and whether it is a crease's.
+        let column = |t: f64| -> Option<(Column, bool)> {
             let uva = side_uv(sa, t);
             let (p, su, sv) = patches[a as usize].first_derivs(surface, uva[0], uva[1]);
             let na = unit_normal(&su, &sv)? * side;
@@ -386,14 +502,27 @@ fn pivot_strips(
             let (lean_a, lean_b) = (nb.dot(&into_a), na.dot(&into_b));
             let convex = lean_a < 0.0 && lean_b < 0.0;
             let concave = lean_a > 0.0 && lean_b > 0.0;
-            (turn > min_turn && (convex || concave)).then_some(Column {
+            let c = Column {
                 s: t,
                 uv_b: uvb,
                 turn,
                 convex,
-            })
+            };
+            Some((c, turn > min_turn && (convex || concave)))
         };
-        let cols: Vec<Option<Column>> = lines(a, sa).iter().map(|&t| column(t)).collect();
+        // Most seams are smooth: a few places along first, where a crease would turn the
+        // normal by over half the least turn.
+        let probes = (0..=CREASE_PROBES).map(|j| j as f64 / CREASE_PROBES as f64);
+        if !probes
+            .filter_map(column)
+            .any(|(c, _)| c.turn > 0.5 * min_turn)
+        {
+            continue;
+        }
+        let cols: Vec<Option<Column>> = lines(a, sa)
+            .iter()
+            .map(|&t| column(t).and_then(|(c, crease)| crease.then_some(c)))
+            .collect();
         // Runs of columns of one kind.
         let mut runs: Vec<Vec<Column>> = Vec::new();
         let mut run: Vec<Column> = Vec::new();
@@ -465,11 +594,11 @@ impl ClMesh {
         // Each patch's grid lines, placed by the density its samples ask for: the
         // parameter speed over the chord the offset's curvature allows, the worst across
         // the other direction.
-        let densities: Vec<[Vec<f64>; 2]> = layout
+        let (densities, tight): (Vec<_>, Vec<_>) = layout
             .patches
             .iter()
-            .map(|patch| density(patch, surface, r, chordal_mm, max_cell_mm))
-            .collect();
+            .map(|patch| density(patch, surface, side, r, chordal_mm, max_cell_mm))
+            .unzip();
         let lines = |scale: f64| -> Vec<[Vec<f64>; 2]> {
             densities.iter().map(|d| grid_lines(d, scale)).collect()
         };
@@ -478,6 +607,24 @@ impl ClMesh {
         if total > MAX_VERTICES {
             // Coarsened evenly: the same density, scaled down.
             breaks = lines((MAX_VERTICES as f64 / total as f64).sqrt());
+        } else {
+            // Cells checked against the offset near tight convex spots.
+            for ((patch, lines), tight) in layout.patches.iter().zip(&mut breaks).zip(&tight) {
+                for dir in 0..2 {
+                    if tight[dir].iter().any(|&t| t) {
+                        lines[dir] = refine_lines(
+                            patch,
+                            surface,
+                            side,
+                            r,
+                            chordal_mm,
+                            dir,
+                            &lines[dir],
+                            &tight[dir],
+                        );
+                    }
+                }
+            }
         }
         let mut vertices = Vec::new();
         let mut triangles = Vec::new();
@@ -511,9 +658,11 @@ impl ClMesh {
             }
             grid_triangles(first, nu, nv, &mut triangles);
         }
-        // Pivot strips along the convex creases, after the patches.
+        // Pivot strips along the creases, after the patches.
+        let views = crate::plan::isoparametric::patch_views(model);
+        let shared = crate::plan::isfc::shared_sides(model, &views);
         let mut strips = Vec::new();
-        for (strip, rows) in pivot_strips(model, &breaks, r, chordal_mm, max_cell_mm) {
+        for (strip, rows) in pivot_strips(model, &shared, &breaks, r, chordal_mm, max_cell_mm) {
             let first = vertices.len() as u32;
             let pi = (layout.patches.len() + strips.len()) as u32;
             let (nu, nv) = (strip.cols.len() - 1, rows);
@@ -547,6 +696,7 @@ impl ClMesh {
             triangles,
             patches,
             strips,
+            shared,
         })
     }
 

@@ -562,8 +562,7 @@ fn cut_plane(
 /// through the CL mesh's vertices on them, joined where sides meet into loops round the
 /// boundary and its holes; `plane` is +∞ (they are cut after the planes).
 fn boundary_passes(model: &Model, mesh: &ClMesh) -> Vec<Pass> {
-    let views = super::isoparametric::patch_views(model);
-    let shared = super::isfc::shared_sides(model, &views);
+    let shared = &mesh.shared;
     let mut passes: Vec<Pass> = Vec::new();
     let layout_patches = &mesh.patches[..mesh.patches.len() - mesh.strips.len()];
     for (p, &(first, [nu, nv])) in layout_patches.iter().enumerate() {
