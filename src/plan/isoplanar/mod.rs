@@ -73,6 +73,9 @@ pub const MAX_SPLITS: usize = 3;
 /// secants for the deformation ratio (they run along a plane; an edge from a point where the
 /// surface faces along x spans about half its angle, a few hundredths).
 const SECANT_MIN_DX: f64 = 1e-3;
+/// A vertex of a side listed as shared lies on the other side when within this many chordal
+/// tolerances of its polyline of contact points (which strays from the curve by up to one).
+const SHARED_SIDE_CHORDALS: f64 = 4.0;
 /// Patch corners closer than this share of the model's diagonal are the same point.
 const BOUNDARY_JOIN_REL: f64 = 1e-7;
 /// Share of the overcut a thinned chord may leave at the slice points it passes over: the
@@ -467,7 +470,11 @@ pub fn slices(
     };
     // Last, a pass along the surface's free boundary: where a boundary runs slanted to the
     // planes, or curves, the last pass of a plane ends short of it.
-    passes.extend(boundary_passes(model, &mesh));
+    passes.extend(boundary_passes(
+        model,
+        &mesh,
+        SHARED_SIDE_CHORDALS * opts.chordal_mm,
+    ));
     passes.extend(crease::groove_passes(&mesh));
     let max_ratio = deformation.ratio.iter().copied().fold(1.0, f64::max);
     let stats = IsoplanarStats {
@@ -558,50 +565,98 @@ fn cut_plane(
     join_at_seams(mesh, passes, seam)
 }
 
-/// Passes along the free sides of the layout's patches (sides no other patch shares),
-/// through the CL mesh's vertices on them, joined where sides meet into loops round the
-/// boundary and its holes; `plane` is +∞ (they are cut after the planes).
-fn boundary_passes(model: &Model, mesh: &ClMesh) -> Vec<Pass> {
+/// Passes along the free sides of the layout's patches (sides, or the parts of sides, no
+/// other patch shares: a side's vertex farther than `tol` (mm) from every side it is listed
+/// as sharing is free), through the CL mesh's vertices on them, joined where sides meet into
+/// loops round the boundary and its holes; `plane` is +∞ (they are cut after the planes).
+fn boundary_passes(model: &Model, mesh: &ClMesh, tol: f64) -> Vec<Pass> {
     let shared = &mesh.shared;
     let mut passes: Vec<Pass> = Vec::new();
     let layout_patches = &mesh.patches[..mesh.patches.len() - mesh.strips.len()];
-    for (p, &(first, [nu, nv])) in layout_patches.iter().enumerate() {
+    // A side's vertices, in order round its patch.
+    let side_vertices = |p: usize, side: u8| -> Vec<u32> {
+        let (first, [nu, nv]) = layout_patches[p];
+        let ij: Vec<(usize, usize)> = match side {
+            0 => (0..=nu).map(|i| (i, 0)).collect(),
+            1 => (0..=nv).map(|j| (nu, j)).collect(),
+            2 => (0..=nu).rev().map(|i| (i, nv)).collect(),
+            _ => (0..=nv).rev().map(|j| (0, j)).collect(),
+        };
+        ij.into_iter()
+            .map(|(i, j)| first + (j * (nu + 1) + i) as u32)
+            .filter(|&id| mesh.vertices[id as usize].is_some())
+            .collect()
+    };
+    for p in 0..layout_patches.len() {
         for side in 0..4u8 {
-            if shared.iter().any(|&(a, sa, b, sb)| {
-                (a as usize, sa) == (p, side) || (b as usize, sb) == (p, side)
-            }) {
-                continue;
-            }
-            let ij: Vec<(usize, usize)> = match side {
-                0 => (0..=nu).map(|i| (i, 0)).collect(),
-                1 => (0..=nv).map(|j| (nu, j)).collect(),
-                2 => (0..=nu).rev().map(|i| (i, nv)).collect(),
-                _ => (0..=nv).rev().map(|j| (0, j)).collect(),
-            };
-            let points: Vec<SlicePoint> = ij
-                .into_iter()
-                .filter_map(|(i, j)| {
-                    let id = first + (j * (nu + 1) + i) as u32;
-                    let v = mesh.vertices[id as usize]?;
-                    Some(SlicePoint {
-                        hit: slice::Hit {
-                            a: id,
-                            b: id,
-                            t: 0.0,
-                        },
-                        patch: p as u32,
-                        uv: v.uv,
-                        mesh_cl: v.cl,
-                        deformed: [f64::INFINITY, 0.0, 0.0],
+            // The sides this one is listed as sharing (wholly or in part), as polylines of
+            // contact points.
+            let partners: Vec<Vec<Point3>> = shared
+                .iter()
+                .filter_map(|&(a, sa, b, sb)| {
+                    if (a as usize, sa) == (p, side) {
+                        Some((b, sb))
+                    } else if (b as usize, sb) == (p, side) {
+                        Some((a, sa))
+                    } else {
+                        None
+                    }
+                })
+                .map(|(q, sq)| {
+                    side_vertices(q as usize, sq)
+                        .iter()
+                        .map(|&id| mesh.vertex(id).cc)
+                        .collect()
+                })
+                .collect();
+            let ids = side_vertices(p, side);
+            let free: Vec<bool> = ids
+                .iter()
+                .map(|&id| {
+                    let c = mesh.vertex(id).cc;
+                    partners.iter().all(|line| {
+                        line.windows(2)
+                            .all(|w| dist_to_segment(&c, &w[0], &w[1]) > tol)
                     })
                 })
                 .collect();
-            if points.len() >= 2 {
-                passes.push(Pass {
-                    plane: f64::INFINITY,
-                    points,
-                    closed: false,
-                });
+            // Each run of free vertices with the shared vertex on either side of it.
+            let mut k = 0;
+            while k < ids.len() {
+                if !free[k] {
+                    k += 1;
+                    continue;
+                }
+                let mut end = k;
+                while end + 1 < ids.len() && free[end + 1] {
+                    end += 1;
+                }
+                let run = &ids[k.saturating_sub(1)..(end + 2).min(ids.len())];
+                let points: Vec<SlicePoint> = run
+                    .iter()
+                    .map(|&id| {
+                        let v = mesh.vertex(id);
+                        SlicePoint {
+                            hit: slice::Hit {
+                                a: id,
+                                b: id,
+                                t: 0.0,
+                            },
+                            patch: p as u32,
+                            uv: v.uv,
+                            mesh_cl: v.cl,
+                            deformed: [f64::INFINITY, 0.0, 0.0],
+                        }
+                    })
+                    .collect();
+                if points.len() >= 2 {
+                    passes.push(Pass {
+                        plane: f64::INFINITY,
+                        points,
+                        closed: false,
+                    });
+                }
+                k = end + 1;
             }
         }
     }
@@ -1601,7 +1656,7 @@ mod tests {
         let m = samples::load_sample("keycap-convex").unwrap();
         let mesh = ClMesh::new(&m, 0.5, 0.01, 0.5).unwrap();
         let tol = BOUNDARY_JOIN_REL * m.surface.bbox().diagonal().max(1.0);
-        let passes = boundary_passes(&m, &mesh);
+        let passes = boundary_passes(&m, &mesh, 0.01);
         let mut crossings = 0;
         for pass in &passes {
             let mut pts = pass.points.clone();
