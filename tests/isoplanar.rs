@@ -348,6 +348,34 @@ fn the_papers_axis_follows_the_area_weighted_facet_normal_on_the_five_axis_head(
     assert!(plain_close < close / 2, "{plain_close} vs {close}");
 }
 
+/// Plans `m` with `o` and simulates the cut: proven (error bound ≤ h / 4), nothing over the
+/// scallop, nothing uncut, no gouge; `what` names it in the summary printed.
+fn cut_is_clean(what: &str, m: &Model, o: &PlanOptions) -> Planned {
+    let (planned, v) = plan_and_verify(m, o);
+    let rep = planned.report(o);
+    println!(
+        "{what}: {} planes, {} pieces, {} retractions, {:.0} mm; simulated max {:.5} mm at {:?} (bound {:.5}), uncut {:.4} %, {} gouges",
+        rep.planes.unwrap(),
+        rep.segments.unwrap(),
+        rep.retractions,
+        rep.length_mm,
+        v.max_scallop_mm,
+        v.max_scallop_at_mm,
+        v.error_bound_mm,
+        100.0 * v.uncut_fraction,
+        v.gouge_count
+    );
+    assert!(v.error_bound_mm <= 0.25 * o.scallop_mm, "{what}: unproven");
+    assert!(
+        v.max_scallop_mm <= o.scallop_mm,
+        "{what}: {} mm left",
+        v.max_scallop_mm
+    );
+    assert_eq!(v.uncut_fraction, 0.0, "{what}");
+    assert_eq!(v.gouge_count, 0, "{what}");
+    planned
+}
+
 /// A roof (`ridge` 1) or a valley (−1): two planes `z = s·slope·(5 − |x − 5|)` (mm, `s` the
 /// sign; the valley raised to lie above z 0) meeting along Y at x 5, tagged infinitely sharp,
 /// 10 mm long. Every control point of a side lies on its plane, so the limit surface is
@@ -457,26 +485,7 @@ fn a_convex_crease_gets_a_strip_of_pivoting_ball_centres_and_its_ridge_is_cut() 
         "{seen} strip vertices"
     );
     // Planes parallel to the ridge (0°): the cut keeps the scallop on the ridge too.
-    let (planned, v) = plan_and_verify(&m, &o);
-    let rep = planned.report(&o);
-    println!(
-        "roof at 0°: {} planes, {:.0} mm; simulated max {:.5} mm at {:?} (bound {:.5}), uncut {:.4} %, {} gouges",
-        rep.planes.unwrap(),
-        rep.length_mm,
-        v.max_scallop_mm,
-        v.max_scallop_at_mm,
-        v.error_bound_mm,
-        100.0 * v.uncut_fraction,
-        v.gouge_count
-    );
-    assert!(v.error_bound_mm <= 0.25 * o.scallop_mm, "unproven");
-    assert!(
-        v.max_scallop_mm <= o.scallop_mm,
-        "{} mm left",
-        v.max_scallop_mm
-    );
-    assert_eq!(v.uncut_fraction, 0.0);
-    assert_eq!(v.gouge_count, 0);
+    cut_is_clean("roof at 0°", &m, &o);
 }
 
 /// Issue 16: at a concave crease the two sides' offsets cross; the planes' passes ran on past
@@ -498,31 +507,7 @@ fn passes_end_at_a_concave_creases_groove_and_a_pass_runs_along_it() {
             vec![false],
             "one concave crease"
         );
-        let (planned, v) = plan_and_verify(&m, &o);
-        let rep = planned.report(&o);
-        println!(
-            "valley at {angle}°: {} planes, {} pieces, {} retractions, {:.0} mm; simulated max {:.5} mm at {:?} (bound {:.5}), uncut {:.4} %, {} gouges",
-            rep.planes.unwrap(),
-            rep.segments.unwrap(),
-            rep.retractions,
-            rep.length_mm,
-            v.max_scallop_mm,
-            v.max_scallop_at_mm,
-            v.error_bound_mm,
-            100.0 * v.uncut_fraction,
-            v.gouge_count
-        );
-        assert!(
-            v.error_bound_mm <= 0.25 * o.scallop_mm,
-            "{angle}°: unproven"
-        );
-        assert!(
-            v.max_scallop_mm <= o.scallop_mm,
-            "{angle}°: {} mm",
-            v.max_scallop_mm
-        );
-        assert_eq!(v.uncut_fraction, 0.0, "{angle}°");
-        assert_eq!(v.gouge_count, 0, "{angle}°");
+        let planned = cut_is_clean(&format!("valley at {angle}°"), &m, &o);
         // The groove's pass: moves whose ball touches the crease's both sides, a radius
         // from each plane, over the crease's length (10 mm).
         let k = (1.0f64 + 8f64.to_radians().tan().powi(2)).sqrt();

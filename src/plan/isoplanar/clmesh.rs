@@ -1,8 +1,11 @@
 //! The cutter-location (CL) surface as a triangle mesh: per layout patch a grid in the
 //! patch's `(u, v)`, fine enough that the mesh of ball centres stays within the chordal
 //! tolerance of the true offset (its lines closer together where the curvature and the
-//! parameter speed ask, not evenly at the patch's worst), each vertex a ball centre a tool radius along the exact
-//! limit-surface normal (not a vertex normal of a coarse mesh) from its contact point.
+//! parameter speed ask, not evenly at the patch's worst; near spots convex tighter than the
+//! ball, where sampled curvature can miss how fast the ball centres swing, each cell checked
+//! against the offset at its middle and halved while it strays), each vertex a ball centre a
+//! tool radius along the exact limit-surface normal (not a vertex normal of a coarse mesh)
+//! from its contact point.
 //!
 //! Where the surface is concave with a radius below the ball's, or folds, the offset
 //! self-intersects and some of its vertices lie closer than a radius to the surface; they
@@ -39,8 +42,9 @@ use crate::surface::{DiffGeom, SurfaceDerivs};
 /// direction.
 ///
 /// Also, per side and sample, whether the surface there is convex towards the tool with a
-/// radius under the ball's ([`TIGHT_CONVEX_RK`]) somewhere across the other direction (`side` is the tool's
-/// side, [`Model::tool_side`]): where [`refine_lines`] checks the cells.
+/// radius under the ball's ([`TIGHT_CONVEX_RK`]) somewhere across the other direction
+/// (`side` is the tool's side, [`Model::tool_side`]): where [`refine_lines`] checks the
+/// cells.
 fn density(
     patch: &crate::layout::Patch,
     surface: &crate::surface::Surface,
