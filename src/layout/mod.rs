@@ -865,6 +865,26 @@ impl<'a> PatchLine<'a> {
     }
 }
 
+/// Patch parameters at `t` along side `side` of a patch (0: `v = 0`, 1: `u = 1`, 2: `v = 1`,
+/// 3: `u = 0`; `t` is the other parameter, increasing with it).
+pub fn side_uv(side: u8, t: f64) -> [f64; 2] {
+    match side {
+        0 => [t, 0.0],
+        1 => [1.0, t],
+        2 => [t, 1.0],
+        _ => [0.0, t],
+    }
+}
+
+/// The parameter along side `side` (as [`side_uv`] takes it) of patch parameters `uv`.
+pub fn side_param(side: u8, uv: [f64; 2]) -> f64 {
+    if side % 2 == 0 {
+        uv[0]
+    } else {
+        uv[1]
+    }
+}
+
 impl Patch {
     fn from_cells(cells: &Cells, chunk: &[(usize, Placement)]) -> Patch {
         let mut pieces = Vec::with_capacity(chunk.len());

@@ -370,12 +370,6 @@ pub(crate) fn shared_sides(model: &Model, views: &[PatchView]) -> Vec<(u32, u8, 
         .map(|k| bbox.max[k] - bbox.min[k])
         .fold(0.0, f64::max);
     let tol = SIDE_MATCH_REL * size.max(1.0);
-    let side_at = |side: u8, t: f64| match side {
-        0 => [t, 0.0],
-        1 => [1.0, t],
-        2 => [t, 1.0],
-        _ => [0.0, t],
-    };
     // Each side as a polyline, with its box and its longest chord.
     let curves: Vec<[Vec<Point3>; 4]> = views
         .iter()
@@ -383,7 +377,8 @@ pub(crate) fn shared_sides(model: &Model, views: &[PatchView]) -> Vec<(u32, u8, 
             [0u8, 1, 2, 3].map(|side| {
                 (0..=SIDE_CURVE_SAMPLES)
                     .map(|k| {
-                        let [u, w] = side_at(side, k as f64 / SIDE_CURVE_SAMPLES as f64);
+                        let [u, w] =
+                            crate::layout::side_uv(side, k as f64 / SIDE_CURVE_SAMPLES as f64);
                         v.subs(u, w)
                     })
                     .collect()

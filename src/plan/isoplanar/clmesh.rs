@@ -29,6 +29,7 @@
 
 use crate::error::{Error, Result};
 use crate::geom::{Point3, Vector3};
+use crate::layout::{side_param, side_uv};
 use crate::model::Model;
 use crate::plan::stepover;
 use crate::surface::diffgeom::unit_normal;
@@ -283,16 +284,6 @@ pub struct Strip {
     pub cols: Vec<(f64, [f64; 2])>,
 }
 
-/// Patch parameters of side `side` (0: `v = 0`, 1: `u = 1`, 2: `v = 1`, 3: `u = 0`) at `t`.
-pub fn side_uv(side: u8, t: f64) -> [f64; 2] {
-    match side {
-        0 => [t, 0.0],
-        1 => [1.0, t],
-        2 => [t, 1.0],
-        _ => [0.0, t],
-    }
-}
-
 /// Of first derivatives `su`, `sv` on side `side`: the one along the side, and the one into
 /// the patch from it.
 fn along_into(side: u8, su: Vector3, sv: Vector3) -> (Vector3, Vector3) {
@@ -321,15 +312,6 @@ pub fn pivot_normal(na: &Vector3, nb: &Vector3, k: f64) -> Vector3 {
             .unwrap_or(*na);
     }
     (*na * ((1.0 - k) * theta).sin() + *nb * (k * theta).sin()) / s
-}
-
-/// The parameter along side `side` of patch parameters `uv`.
-pub fn along_side(side: u8, uv: [f64; 2]) -> f64 {
-    if side % 2 == 0 {
-        uv[0]
-    } else {
-        uv[1]
-    }
 }
 
 impl Strip {
@@ -363,7 +345,7 @@ impl Strip {
         let mut cols: Vec<(f64, [f64; 2])> = self
             .cols
             .iter()
-            .map(|&(s, uv_b)| (along_side(self.side_b, uv_b), side_uv(self.side, s)))
+            .map(|&(s, uv_b)| (side_param(self.side_b, uv_b), side_uv(self.side, s)))
             .collect();
         cols.sort_by(|x, y| x.0.total_cmp(&y.0));
         Strip {
@@ -374,11 +356,6 @@ impl Strip {
             side_b: self.side,
             cols,
         }
-    }
-
-    /// Patch `a`'s parameters of the contact point at strip parameter `s`.
-    pub fn uv_on_a(&self, s: f64) -> [f64; 2] {
-        side_uv(self.side, s)
     }
 }
 

@@ -13,14 +13,32 @@
 //! Owns: the concave creases' passes and the trimming at them. Must not: slice, or place
 //! moves.
 
-use super::clmesh::{along_side, ClMesh, Strip};
-use super::{slice, Pass, SlicePoint};
+use super::clmesh::{ClMesh, Strip};
+use super::{Pass, SlicePoint};
 use crate::geom::{Point3, Vector3};
+use crate::layout::side_param;
 use crate::model::Model;
 
 /// Ball centres farther than this many tool radii from the crease point beside them are not
 /// held against it (they lie on the patch's far side, or past the crease's end).
 const REACH_RADII: f64 = 2.0;
+
+/// A concave crease's groove at one place: the crease point, and the unit normal of the
+/// plane through it half-way between the two sides' normals, towards one side.
+#[derive(Debug, Clone, Copy)]
+struct Groove {
+    q: Point3,
+    w: Vector3,
+}
+
+impl Groove {
+    /// How far (mm) CL point `cl` lies on the groove's side of its half-way plane (negative:
+    /// past it), if within reach of the crease point.
+    fn own_side(&self, cl: &Point3, r: f64) -> Option<f64> {
+        let off = cl - self.q;
+        (off.norm() <= REACH_RADII * r).then(|| off.dot(&self.w))
+    }
+}
 
 /// The concave creases of a CL mesh, each seen from both of its patches.
 pub struct Creases {
@@ -39,51 +57,43 @@ impl Creases {
         Creases { sides }
     }
 
-    /// How far (mm) the CL point `cl` at patch parameter `s` along crease side `c` lies on
-    /// its own side of the groove (negative: past it), if the crease runs there and the point
-    /// is within reach of it.
-    fn own_side(&self, model: &Model, c: &Strip, s: f64, cl: &Point3, r: f64) -> Option<f64> {
+    /// The groove of crease side `c` at patch parameter `s` along it, if the crease runs
+    /// there: the crease point and the unit normal of the plane half-way between the two
+    /// sides' normals, pointing to `c`'s own side.
+    fn groove(&self, model: &Model, c: &Strip, s: f64) -> Option<Groove> {
         let (lo, hi) = (c.cols[0].0, c.cols[c.cols.len() - 1].0);
         if !(lo..=hi).contains(&s) {
             return None;
         }
         let (q, n_own, n_other) = c.ends(model, s)?;
-        let off = cl - q;
-        if off.norm() > REACH_RADII * r {
-            return None;
-        }
         let w: Vector3 = (n_other - n_own).try_normalize(0.0)?;
-        Some(off.dot(&w))
+        Some(Groove { q, w })
     }
 
-    /// The crease side and parameter along it past whose groove slice point `p` lies.
-    fn past(&self, model: &Model, p: &SlicePoint, r: f64) -> Option<(usize, f64)> {
-        self.sides.iter().enumerate().find_map(|(k, c)| {
+    /// The groove past which slice point `p` lies (its CL point within reach of the crease
+    /// point beside it, on the other side of the half-way plane), and how far past (mm,
+    /// negative).
+    fn past(&self, model: &Model, p: &SlicePoint, r: f64) -> Option<(Groove, f64)> {
+        self.sides.iter().find_map(|c| {
             if c.a != p.patch {
                 return None;
             }
-            let s = along_side(c.side, p.uv);
-            let d = self.own_side(model, c, s, &p.mesh_cl, r)?;
-            (d < 0.0).then_some((k, s))
+            let g = self.groove(model, c, side_param(c.side, p.uv))?;
+            let d = g.own_side(&p.mesh_cl, r)?;
+            (d < 0.0).then_some((g, d))
         })
     }
 
-    /// Where between `inside` and `out` (slice points of one patch, `out` past the groove of
-    /// crease side `k` at `s`) the CL mesh crosses the groove, as a slice point between
-    /// them (linear in the patch parameters and on the mesh).
+    /// Where between `inside` and `out` (slice points of one patch, `out` past groove `g`
+    /// by `d_out`) the CL mesh crosses the groove, as a slice point between them (linear in
+    /// the patch parameters and on the mesh).
     fn crossing(
-        &self,
-        model: &Model,
-        (k, s): (usize, f64),
+        (g, d_out): (Groove, f64),
         inside: &SlicePoint,
         out: &SlicePoint,
         r: f64,
     ) -> SlicePoint {
-        let c = &self.sides[k];
-        let d_out = self.own_side(model, c, s, &out.mesh_cl, r).unwrap_or(0.0);
-        let d_in = self
-            .own_side(model, c, s, &inside.mesh_cl, r)
-            .unwrap_or(0.0);
+        let d_in = g.own_side(&inside.mesh_cl, r).unwrap_or(0.0);
         let f = if d_in > 0.0 && d_out < 0.0 {
             d_in / (d_in - d_out)
         } else {
@@ -119,19 +129,27 @@ impl Creases {
                 out.extend_from_slice(run);
                 continue;
             }
-            let past = |p: &SlicePoint| self.past(model, p, r);
-            let Some(lo) = run.iter().position(|p| past(p).is_none()) else {
+            // From either end, the points past a groove, and the groove of the last of them.
+            let from = |order: &mut dyn Iterator<Item = usize>| {
+                let mut last = None;
+                for k in order {
+                    match self.past(model, &run[k], r) {
+                        Some(at) => last = Some((k, at)),
+                        None => return Some((k, last)),
+                    }
+                }
+                None
+            };
+            let Some((lo, before)) = from(&mut (0..run.len())) else {
                 continue;
             };
-            let hi = run.iter().rposition(|p| past(p).is_none()).unwrap_or(lo);
-            if lo > 0 {
-                let at = past(&run[lo - 1]).expect("past");
-                out.push(self.crossing(model, at, &run[lo], &run[lo - 1], r));
+            let (hi, after) = from(&mut (0..run.len()).rev()).expect("a point is not past");
+            if let Some((k, at)) = before {
+                out.push(Self::crossing(at, &run[lo], &run[k], r));
             }
             out.extend_from_slice(&run[lo..=hi]);
-            if hi + 1 < run.len() {
-                let at = past(&run[hi + 1]).expect("past");
-                out.push(self.crossing(model, at, &run[hi], &run[hi + 1], r));
+            if let Some((k, at)) = after {
+                out.push(Self::crossing(at, &run[hi], &run[k], r));
             }
         }
         out
@@ -151,20 +169,8 @@ pub fn groove_passes(mesh: &ClMesh) -> Vec<Pass> {
             let pi = first_strip + k;
             let (first, [nu, _]) = mesh.patches[pi];
             let points = (first..=first + nu as u32)
-                .filter_map(|id| {
-                    let v = mesh.vertices[id as usize]?;
-                    Some(SlicePoint {
-                        hit: slice::Hit {
-                            a: id,
-                            b: id,
-                            t: 0.0,
-                        },
-                        patch: pi as u32,
-                        uv: v.uv,
-                        mesh_cl: v.cl,
-                        deformed: [f64::INFINITY, 0.0, 0.0],
-                    })
-                })
+                .filter(|&id| mesh.vertices[id as usize].is_some())
+                .map(|id| SlicePoint::at_vertex(mesh, id))
                 .collect();
             Pass {
                 plane: f64::INFINITY,

@@ -154,6 +154,31 @@ pub struct SlicePoint {
     pub deformed: [f64; 3],
 }
 
+impl SlicePoint {
+    /// Mesh vertex `id` as a point of a pass along vertices (the boundary's, a groove's),
+    /// which belongs to no plane: `x'` is +∞.
+    fn at_vertex(mesh: &ClMesh, id: u32) -> Self {
+        let v = mesh.vertex(id);
+        SlicePoint {
+            hit: slice::Hit {
+                a: id,
+                b: id,
+                t: 0.0,
+            },
+            patch: v.patch,
+            uv: v.uv,
+            mesh_cl: v.cl,
+            deformed: [f64::INFINITY, 0.0, 0.0],
+        }
+    }
+
+    /// Its contact point on the mesh (mm): between those of its edge's ends.
+    fn mesh_cc(&self, mesh: &ClMesh) -> Point3 {
+        let (a, b) = (mesh.vertex(self.hit.a).cc, mesh.vertex(self.hit.b).cc);
+        a + (b - a) * self.hit.t
+    }
+}
+
 /// A connected piece of one plane's slice.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pass {
@@ -634,20 +659,7 @@ fn boundary_passes(model: &Model, mesh: &ClMesh, tol: f64) -> Vec<Pass> {
                 let run = &ids[k.saturating_sub(1)..(end + 2).min(ids.len())];
                 let points: Vec<SlicePoint> = run
                     .iter()
-                    .map(|&id| {
-                        let v = mesh.vertex(id);
-                        SlicePoint {
-                            hit: slice::Hit {
-                                a: id,
-                                b: id,
-                                t: 0.0,
-                            },
-                            patch: p as u32,
-                            uv: v.uv,
-                            mesh_cl: v.cl,
-                            deformed: [f64::INFINITY, 0.0, 0.0],
-                        }
-                    })
+                    .map(|&id| SlicePoint::at_vertex(mesh, id))
                     .collect();
                 if points.len() >= 2 {
                     passes.push(Pass {
@@ -812,10 +824,7 @@ fn join_at_seams(mesh: &ClMesh, mut passes: Vec<Pass>, tol: f64) -> Vec<Pass> {
             .any(|s| !s.convex && ((s.a, s.b) == (p, q) || (s.a, s.b) == (q, p)))
     };
     // A slice point's offset from its contact point (on the mesh).
-    let offset = |p: &SlicePoint| {
-        let (a, b) = (mesh.vertex(p.hit.a).cc, mesh.vertex(p.hit.b).cc);
-        p.mesh_cl - (a + (b - a) * p.hit.t)
-    };
+    let offset = |p: &SlicePoint| p.mesh_cl - p.mesh_cc(mesh);
     loop {
         let mut best: Option<(f64, usize, bool, usize, bool)> = None;
         for i in 0..passes.len() {
@@ -908,8 +917,7 @@ impl PassChecks {
                 continue;
             }
             if mesh.strip(s.patch).is_some() {
-                let (a, b) = (mesh.vertex(s.hit.a).cc, mesh.vertex(s.hit.b).cc);
-                let cc = a + (b - a) * s.hit.t;
+                let cc = s.mesh_cc(mesh);
                 if let Some(a) = last_cc {
                     out.segments.push((a, cc));
                 }
@@ -1557,7 +1565,7 @@ impl Emit<'_> {
         match self.mesh.strip(p.patch) {
             Some(strip) => SurfacePoint {
                 patch: strip.a,
-                uv: strip.uv_on_a(p.uv[0]),
+                uv: crate::layout::side_uv(strip.side, p.uv[0]),
                 ..*p
             },
             None => *p,
