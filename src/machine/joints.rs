@@ -109,20 +109,19 @@ struct State {
     rotary_deg: [f64; 2],
     /// Orientation branch; `None` at the singular pose.
     branch: Option<u8>,
-    xyz_mm: [f64; 3],
     /// Rotary travel from the start of the path (degrees).
     travel_deg: f64,
     /// Index of the state at the previous move it comes from.
-    back: usize,
+    back: u32,
 }
 
-impl State {
-    fn joints(&self) -> Joints {
-        Joints {
-            xyz_mm: self.xyz_mm,
-            rotary_deg: self.rotary_deg,
-        }
-    }
+/// What the way back needs of a state once its layer is done (the linear joints follow
+/// from the rotaries and the move's tip): a quarter of the whole state, which on the head's
+/// 197 571 moves took 16 MB.
+#[derive(Debug, Clone, Copy)]
+struct Kept {
+    rotary_deg: [f64; 2],
+    back: u32,
 }
 
 /// True when `a` and `b` are the same state (endless axes up to whole turns).
@@ -139,20 +138,19 @@ fn same_state(machine: &Machine, a: &State, b: &State) -> bool {
         })
 }
 
-/// The solutions the rules allow at move `i` coming from `from` at move `i − 1` (limits not
-/// yet applied).
+/// The solutions the rules allow at move `i`, pose `p`, coming from `from` at move `i − 1`,
+/// pose `before` (`None` at the first move; limits not yet applied).
 fn allowed(
     machine: &Machine,
-    poses: &[PoseRequest],
+    (p, before): (&PoseRequest, Option<&PoseRequest>),
     i: usize,
     from: &State,
 ) -> Result<Vec<RotarySolution>> {
-    let p = &poses[i];
-    if i == 0 || p.starts_chain {
+    let Some(before) = before.filter(|_| !p.starts_chain) else {
         return machine
             .rotary_solutions(&p.axis, from.rotary_deg, true)
             .map_err(|Unreachable| unreachable(machine, i, &p.axis));
-    }
+    };
     let free = machine
         .rotary_solutions(&p.axis, from.rotary_deg, false)
         .map_err(|Unreachable| unreachable(machine, i, &p.axis))?;
@@ -160,8 +158,7 @@ fn allowed(
         .iter()
         .map(|s| distance(s.rotary_deg, from.rotary_deg))
         .fold(f64::INFINITY, f64::min);
-    let continuation =
-        from.branch.is_some() && !machine.arc_meets_singular(&poses[i - 1].axis, &p.axis);
+    let continuation = from.branch.is_some() && !machine.arc_meets_singular(&before.axis, &p.axis);
     Ok(free
         .into_iter()
         .filter(|s| {
@@ -171,56 +168,60 @@ fn allowed(
         .collect())
 }
 
-/// The tool tip of every move of `path` (the ball centre less the radius along the axis).
-pub fn tips(path: &crate::plan::Toolpath) -> Vec<Point3> {
-    let r = path.tool_radius_mm;
-    path.moves
-        .iter()
-        .map(|m| m.cl_point - m.tool_axis * r)
-        .collect()
+/// The tool tip of move `i` of `path` (the ball centre less the radius along the axis).
+pub fn tip(path: &crate::plan::Toolpath, i: usize) -> Point3 {
+    let m = &path.moves[i];
+    m.cl_point - m.tool_axis * path.tool_radius_mm
 }
 
-/// The pose every move of `path` asks for, its tips being `tips`: a rapid (and the first
-/// move) starts a chain, where the rotaries may re-choose.
-pub fn path_requests(path: &crate::plan::Toolpath, tips: &[Point3]) -> Vec<PoseRequest> {
-    path.moves
-        .iter()
-        .zip(tips)
-        .enumerate()
-        .map(|(i, (m, t))| PoseRequest {
-            tip: *t,
-            axis: m.tool_axis,
-            starts_chain: i == 0 || m.kind == crate::plan::MoveKind::Rapid,
-        })
-        .collect()
+/// The tool tip of every move of `path`.
+pub fn tips(path: &crate::plan::Toolpath) -> Vec<Point3> {
+    (0..path.moves.len()).map(|i| tip(path, i)).collect()
+}
+
+/// The pose move `i` of `path` asks for: a rapid (and the first move) starts a chain, where
+/// the rotaries may re-choose.
+pub fn path_request(path: &crate::plan::Toolpath, i: usize) -> PoseRequest {
+    let m = &path.moves[i];
+    PoseRequest {
+        tip: tip(path, i),
+        axis: m.tool_axis,
+        starts_chain: i == 0 || m.kind == crate::plan::MoveKind::Rapid,
+    }
 }
 
 /// The joint values of every pose (see the module documentation for how they are chosen), or
 /// an error naming the first move the machine cannot do.
 pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
+    solve_by(machine, poses.len(), |i| poses[i])
+}
+
+/// [`solve`] for `n` poses made on demand by `pose(i)` (each is asked for twice), so that a
+/// long path's poses need not be held at once.
+pub fn solve_by(
+    machine: &Machine,
+    n: usize,
+    pose: impl Fn(usize) -> PoseRequest,
+) -> Result<Vec<Joints>> {
     let home = State {
         rotary_deg: [0.0; 2],
         branch: None,
-        xyz_mm: [0.0; 3],
         travel_deg: 0.0,
         back: 0,
     };
-    // The layers one after another in one vector (layer `i` is `states[starts[i]..starts[i
-    // + 1]]`): a vector per move took its least capacity of four states, 256 bytes, for the one
+    // The layers one after another in one vector (layer `i` is `kept[starts[i]..starts[i +
+    // 1]]`): a vector per move took its least capacity of four states, 256 bytes, for the one
     // or two most moves have (50 MB of the head's 197 571 moves).
-    let mut states: Vec<State> = Vec::with_capacity(poses.len() + poses.len() / 4);
-    let mut starts: Vec<usize> = Vec::with_capacity(poses.len() + 1);
+    let mut kept: Vec<Kept> = Vec::with_capacity(n + n / 4);
+    let mut starts: Vec<u32> = Vec::with_capacity(n + 1);
     starts.push(0);
-    let mut next: Vec<State> = Vec::new();
-    for (i, p) in poses.iter().enumerate() {
-        let from: &[State] = if i == 0 {
-            std::slice::from_ref(&home)
-        } else {
-            &states[starts[i - 1]..starts[i]]
-        };
+    let (mut from, mut next): (Vec<State>, Vec<State>) = (vec![home], Vec::new());
+    let mut before: Option<PoseRequest> = None;
+    for i in 0..n {
+        let p = pose(i);
         next.clear();
         for (k, f) in from.iter().enumerate() {
-            for s in allowed(machine, poses, i, f)? {
+            for s in allowed(machine, (&p, before.as_ref()), i, f)? {
                 let Some(rotary_deg) = machine.within_limits(s.rotary_deg) else {
                     continue;
                 };
@@ -231,9 +232,8 @@ pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
                 let state = State {
                     rotary_deg,
                     branch: (!s.singular).then_some(s.branch),
-                    xyz_mm,
                     travel_deg: f.travel_deg + distance(rotary_deg, f.rotary_deg),
-                    back: k,
+                    back: k as u32,
                 };
                 match next.iter_mut().find(|n| same_state(machine, n, &state)) {
                     Some(n) if n.travel_deg <= state.travel_deg => {}
@@ -243,30 +243,45 @@ pub fn solve(machine: &Machine, poses: &[PoseRequest]) -> Result<Vec<Joints>> {
             }
         }
         if next.is_empty() {
-            return Err(dead_end(machine, poses, i, from));
+            return Err(dead_end(machine, &p, i, &from));
         }
-        states.extend_from_slice(&next);
-        starts.push(states.len());
+        kept.extend(next.iter().map(|s| Kept {
+            rotary_deg: s.rotary_deg,
+            back: s.back,
+        }));
+        starts.push(kept.len() as u32);
+        std::mem::swap(&mut from, &mut next);
+        before = Some(p);
     }
-    let layer = |i: usize| &states[starts[i]..starts[i + 1]];
-    let Some(n) = poses.len().checked_sub(1) else {
+    let Some(last) = n.checked_sub(1) else {
         return Ok(Vec::new());
     };
-    let last = layer(n);
-    let mut k = (0..last.len())
-        .min_by(|&a, &b| last[a].travel_deg.total_cmp(&last[b].travel_deg))
+    let layer = |i: usize| &kept[starts[i] as usize..starts[i + 1] as usize];
+    // `from` is the last layer, with its travel.
+    let mut k = (0..from.len())
+        .min_by(|&a, &b| from[a].travel_deg.total_cmp(&from[b].travel_deg))
         .expect("a layer is never empty");
-    let mut out = vec![home.joints(); poses.len()];
-    for i in (0..poses.len()).rev() {
-        out[i] = layer(i)[k].joints();
-        k = layer(i)[k].back;
+    debug_assert_eq!(from.len(), layer(last).len());
+    let mut out = vec![
+        Joints {
+            xyz_mm: [0.0; 3],
+            rotary_deg: [0.0; 2],
+        };
+        n
+    ];
+    for i in (0..n).rev() {
+        let s = layer(i)[k];
+        out[i] = Joints {
+            xyz_mm: machine.linear_joints(&pose(i).tip, s.rotary_deg),
+            rotary_deg: s.rotary_deg,
+        };
+        k = s.back as usize;
     }
     Ok(out)
 }
 
 /// Why no allowed solution exists at move `i`, said from the cheapest state before it.
-fn dead_end(machine: &Machine, poses: &[PoseRequest], i: usize, from: &[State]) -> Error {
-    let p = &poses[i];
+fn dead_end(machine: &Machine, p: &PoseRequest, i: usize, from: &[State]) -> Error {
     let f = from
         .iter()
         .min_by(|a, b| a.travel_deg.total_cmp(&b.travel_deg))

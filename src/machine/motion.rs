@@ -361,16 +361,26 @@ fn corner_speed(a: &Profile, b: &Profile, d: &Dynamics) -> f64 {
 /// Seconds each segment takes (same order), with the machine stopped before the first
 /// and after the last. `rotary_feed_deg_min` is the rotaries' fastest rate.
 pub fn segment_times(segs: &[Segment], rotary_feed_deg_min: f64, d: &Dynamics) -> Vec<f64> {
-    let n = segs.len();
-    let m: Vec<Profile> = segs
-        .iter()
-        .map(|s| profile(s, rotary_feed_deg_min, d))
-        .collect();
+    segment_times_by(segs.len(), |k| segs[k], rotary_feed_deg_min, d).collect()
+}
+
+/// [`segment_times`] of the `n` segments `seg(k)` makes on demand (each is asked for four
+/// times): a long path's segments and profiles need not be held at once, only a speed per
+/// corner.
+pub fn segment_times_by<'a>(
+    n: usize,
+    seg: impl Fn(usize) -> Segment + 'a,
+    rotary_feed_deg_min: f64,
+    d: &'a Dynamics,
+) -> impl Iterator<Item = f64> + 'a {
+    let m = move |k: usize| profile(&seg(k), rotary_feed_deg_min, d);
     // Corner k joins move k-1 and move k, as a speed in the corner rule's space; corners 0
     // and n are the start and end (stopped).
     let mut w = vec![0.0; n + 1];
+    let mut before = (n > 0).then(|| m(0));
     for k in 1..n {
-        let (a, b) = (&m[k - 1], &m[k]);
+        let b = m(k);
+        let a = before.as_ref().expect("set for every k below n");
         let cap_a = if a.to_path > 0.0 {
             a.top / a.to_path
         } else {
@@ -381,11 +391,12 @@ pub fn segment_times(segs: &[Segment], rotary_feed_deg_min: f64, d: &Dynamics) -
         } else {
             0.0
         };
-        w[k] = corner_speed(a, b, d).min(cap_a).min(cap_b);
+        w[k] = corner_speed(a, &b, d).min(cap_a).min(cap_b);
+        before = Some(b);
     }
     // Backward: every move must brake from its entry to its exit.
     for k in (0..n).rev() {
-        let mv = &m[k];
+        let mv = m(k);
         if mv.p <= NULL_MOVE {
             w[k] = w[k].min(w[k + 1]);
             continue;
@@ -396,7 +407,7 @@ pub fn segment_times(segs: &[Segment], rotary_feed_deg_min: f64, d: &Dynamics) -
     }
     // Forward: and speed up from its entry to its exit.
     for k in 0..n {
-        let mv = &m[k];
+        let mv = m(k);
         if mv.p <= NULL_MOVE {
             w[k + 1] = w[k + 1].min(w[k]);
             continue;
@@ -405,9 +416,10 @@ pub fn segment_times(segs: &[Segment], rotary_feed_deg_min: f64, d: &Dynamics) -
         let exit = reach(entry, mv.p, w[k + 1] * mv.to_path, mv.accel, mv.jerk);
         w[k + 1] = w[k + 1].min(exit / mv.to_path);
     }
-    (0..n)
-        .map(|k| move_time(&m[k], w[k] * m[k].to_path, w[k + 1] * m[k].to_path))
-        .collect()
+    (0..n).map(move |k| {
+        let mv = m(k);
+        move_time(&mv, w[k] * mv.to_path, w[k + 1] * mv.to_path)
+    })
 }
 
 /// How long a path takes on a machine.
@@ -431,47 +443,47 @@ impl PathTimes {
 /// The joint values are the post's ([`joints::solve`]); where the machine cannot take the
 /// path, the tool axis' turn stands in for the rotaries'.
 pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> PathTimes {
-    let tips = joints::tips(path);
+    let n = path.moves.len();
     let joints = if machine.rotaries.is_empty() {
         None
     } else {
-        joints::solve(machine, &joints::path_requests(path, &tips)).ok()
+        joints::solve_by(machine, n, |i| joints::path_request(path, i)).ok()
     };
     let from_joints = machine.rotaries.is_empty() || joints.is_some();
-    let segs: Vec<Segment> = (1..path.moves.len())
-        .map(|i| {
-            let (a, b) = (&path.moves[i - 1], &path.moves[i]);
-            let tip = tips[i] - tips[i - 1];
-            let (linear_mm, rotary_deg) = match &joints {
-                Some(j) => {
-                    let (p, q) = (&j[i - 1], &j[i]);
-                    (
-                        [0, 1, 2].map(|k| q.xyz_mm[k] - p.xyz_mm[k]),
-                        [0, 1].map(|k| q.rotary_deg[k] - p.rotary_deg[k]),
-                    )
-                }
-                None => {
-                    let turn = a.tool_axis.angle(&b.tool_axis).to_degrees();
-                    ([tip.x, tip.y, tip.z], [turn, 0.0])
-                }
-            };
-            Segment {
-                linear_mm,
-                rotary_deg,
-                tip_length_mm: tip.norm(),
-                feed_mm_min: opts.feed_for(b.kind),
+    let seg = |k: usize| {
+        let i = k + 1;
+        let (a, b) = (&path.moves[i - 1], &path.moves[i]);
+        let tip = joints::tip(path, i) - joints::tip(path, i - 1);
+        let (linear_mm, rotary_deg) = match &joints {
+            Some(j) => {
+                let (p, q) = (&j[i - 1], &j[i]);
+                (
+                    [0, 1, 2].map(|k| q.xyz_mm[k] - p.xyz_mm[k]),
+                    [0, 1].map(|k| q.rotary_deg[k] - p.rotary_deg[k]),
+                )
             }
-        })
-        .collect();
-    let mut seconds = Vec::with_capacity(path.moves.len());
-    if !path.moves.is_empty() {
+            None => {
+                let turn = a.tool_axis.angle(&b.tool_axis).to_degrees();
+                ([tip.x, tip.y, tip.z], [turn, 0.0])
+            }
+        };
+        Segment {
+            linear_mm,
+            rotary_deg,
+            tip_length_mm: tip.norm(),
+            feed_mm_min: opts.feed_for(b.kind),
+        }
+    };
+    let mut seconds = Vec::with_capacity(n);
+    if n > 0 {
         seconds.push(0.0);
+        seconds.extend(segment_times_by(
+            n - 1,
+            seg,
+            machine.max_rotary_feed_deg_min,
+            &machine.dynamics,
+        ));
     }
-    seconds.extend(segment_times(
-        &segs,
-        machine.max_rotary_feed_deg_min,
-        &machine.dynamics,
-    ));
     PathTimes {
         seconds,
         from_joints,

@@ -519,7 +519,7 @@ pub fn post_program(
         }
         out
     } else {
-        joints::solve(machine, &joints::path_requests(path, &tips))?
+        joints::solve_by(machine, path.moves.len(), |i| joints::path_request(path, i))?
     };
 
     // Rotary words in address order (A, B, C).
