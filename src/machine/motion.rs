@@ -112,13 +112,19 @@ pub struct Segment {
 /// A move's motion along its own path coordinate `p` (joint-space mm, or degrees for a move
 /// that only turns): length, top speed, acceleration and jerk (per second).
 #[derive(Debug, Clone, Copy)]
-struct Profile {
+struct Motion {
     p: f64,
     top: f64,
     accel: f64,
     jerk: f64,
     /// Path speed per unit of corner speed (joint-space speed scaled as in the corner rule).
     to_path: f64,
+}
+
+/// A move's [`Motion`] and what the corner rule needs of it.
+#[derive(Debug, Clone, Copy)]
+struct Profile {
+    motion: Motion,
     /// Unit direction in scaled joint space (x, y, z, r1, r2), `None` for a null move.
     dir: Option<[f64; 5]>,
     rapid: bool,
@@ -165,11 +171,13 @@ fn profile(s: &Segment, rotary_feed_deg_min: f64, d: &Dynamics) -> Profile {
     let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     let dir = (norm > NULL_MOVE && !turn_only).then(|| v.map(|x| x / norm));
     Profile {
-        p,
-        top,
-        accel,
-        jerk,
-        to_path: if norm > NULL_MOVE { p / norm } else { 1.0 },
+        motion: Motion {
+            p,
+            top,
+            accel,
+            jerk,
+            to_path: if norm > NULL_MOVE { p / norm } else { 1.0 },
+        },
         dir,
         rapid: s.feed_mm_min.is_none(),
         turn_only,
@@ -242,7 +250,7 @@ fn reach(from: f64, p: f64, cap: f64, accel: f64, jerk: f64) -> f64 {
 }
 
 /// Time (s) of one move entered at `v0` and left at `v1` (path speeds both reachable).
-fn move_time(m: &Profile, v0: f64, v1: f64) -> f64 {
+fn move_time(m: &Motion, v0: f64, v1: f64) -> f64 {
     if m.p <= NULL_MOVE || m.top <= 0.0 {
         return 0.0;
     }
@@ -361,42 +369,44 @@ fn corner_speed(a: &Profile, b: &Profile, d: &Dynamics) -> f64 {
 /// Seconds each segment takes (same order), with the machine stopped before the first
 /// and after the last. `rotary_feed_deg_min` is the rotaries' fastest rate.
 pub fn segment_times(segs: &[Segment], rotary_feed_deg_min: f64, d: &Dynamics) -> Vec<f64> {
-    segment_times_by(segs.len(), |k| segs[k], rotary_feed_deg_min, d).collect()
+    segment_times_by(segs.len(), |k| segs[k], rotary_feed_deg_min, d)
 }
 
-/// [`segment_times`] of the `n` segments `seg(k)` makes on demand (each is asked for four
-/// times): a long path's segments and profiles need not be held at once, only a speed per
+/// [`segment_times`] of the `n` segments `seg(k)` makes on demand: a long path's segments
+/// and whole profiles need not be held at once, only each move's [`Motion`] and a speed per
 /// corner.
-pub fn segment_times_by<'a>(
+pub fn segment_times_by(
     n: usize,
-    seg: impl Fn(usize) -> Segment + 'a,
+    seg: impl Fn(usize) -> Segment,
     rotary_feed_deg_min: f64,
-    d: &'a Dynamics,
-) -> impl Iterator<Item = f64> + 'a {
-    let m = move |k: usize| profile(&seg(k), rotary_feed_deg_min, d);
+    d: &Dynamics,
+) -> Vec<f64> {
+    let profile = |k: usize| profile(&seg(k), rotary_feed_deg_min, d);
     // Corner k joins move k-1 and move k, as a speed in the corner rule's space; corners 0
-    // and n are the start and end (stopped).
+    // and n are the start and end (stopped). The passes below need only the motions.
     let mut w = vec![0.0; n + 1];
-    let mut before = (n > 0).then(|| m(0));
+    let mut m: Vec<Motion> = Vec::with_capacity(n);
+    let mut before = (n > 0).then(|| profile(0));
+    if let Some(a) = &before {
+        m.push(a.motion);
+    }
+    let cap = |p: &Profile| {
+        if p.motion.to_path > 0.0 {
+            p.motion.top / p.motion.to_path
+        } else {
+            0.0
+        }
+    };
     for k in 1..n {
-        let b = m(k);
+        let b = profile(k);
         let a = before.as_ref().expect("set for every k below n");
-        let cap_a = if a.to_path > 0.0 {
-            a.top / a.to_path
-        } else {
-            0.0
-        };
-        let cap_b = if b.to_path > 0.0 {
-            b.top / b.to_path
-        } else {
-            0.0
-        };
-        w[k] = corner_speed(a, &b, d).min(cap_a).min(cap_b);
+        w[k] = corner_speed(a, &b, d).min(cap(a)).min(cap(&b));
+        m.push(b.motion);
         before = Some(b);
     }
     // Backward: every move must brake from its entry to its exit.
     for k in (0..n).rev() {
-        let mv = m(k);
+        let mv = &m[k];
         if mv.p <= NULL_MOVE {
             w[k] = w[k].min(w[k + 1]);
             continue;
@@ -407,7 +417,7 @@ pub fn segment_times_by<'a>(
     }
     // Forward: and speed up from its entry to its exit.
     for k in 0..n {
-        let mv = m(k);
+        let mv = &m[k];
         if mv.p <= NULL_MOVE {
             w[k + 1] = w[k + 1].min(w[k]);
             continue;
@@ -416,10 +426,9 @@ pub fn segment_times_by<'a>(
         let exit = reach(entry, mv.p, w[k + 1] * mv.to_path, mv.accel, mv.jerk);
         w[k + 1] = w[k + 1].min(exit / mv.to_path);
     }
-    (0..n).map(move |k| {
-        let mv = m(k);
-        move_time(&mv, w[k] * mv.to_path, w[k + 1] * mv.to_path)
-    })
+    (0..n)
+        .map(|k| move_time(&m[k], w[k] * m[k].to_path, w[k + 1] * m[k].to_path))
+        .collect()
 }
 
 /// How long a path takes on a machine.
@@ -497,7 +506,7 @@ mod tests {
 
     /// [`move_time`]'s peak speed by plain bisection on `v` (the search before Newton's):
     /// the second method.
-    fn move_time_by_bisection(m: &Profile, v0: f64, v1: f64) -> f64 {
+    fn move_time_by_bisection(m: &Motion, v0: f64, v1: f64) -> f64 {
         let (ta, da) = change(v0, m.top, m.accel, m.jerk);
         let (td, dd) = change(m.top, v1, m.accel, m.jerk);
         if da + dd <= m.p {
@@ -547,15 +556,12 @@ mod tests {
                 _ => reach(v0, p, top * next(), accel, jerk),
             };
             let v0 = v0.min(reach(v1, p, top, accel, jerk));
-            let m = Profile {
+            let m = Motion {
                 p,
                 top,
                 accel,
                 jerk,
                 to_path: 1.0,
-                dir: None,
-                rapid: false,
-                turn_only: false,
             };
             let (got, want) = (move_time(&m, v0, v1), move_time_by_bisection(&m, v0, v1));
             if change(v0, top, accel, jerk).1 + change(top, v1, accel, jerk).1 > p {
@@ -633,11 +639,13 @@ mod tests {
         // the reversed entry and the exit (θ = π straight on, 0 a reversal).
         let d = Dynamics::default();
         let with_dir = |dir: [f64; 5]| Profile {
-            p: 1.0,
-            top: 100.0,
-            accel: 1000.0,
-            jerk: f64::INFINITY,
-            to_path: 1.0,
+            motion: Motion {
+                p: 1.0,
+                top: 100.0,
+                accel: 1000.0,
+                jerk: f64::INFINITY,
+                to_path: 1.0,
+            },
             dir: Some(dir),
             rapid: false,
             turn_only: false,
