@@ -394,6 +394,10 @@ struct Cylinder {
     a0: f64,
     a1: f64,
     rad: f64,
+    /// The axis' components' sizes, for the boxes' reach along it.
+    axis_abs: [f64; 3],
+    /// `(2·rad)²`, for the sphere test.
+    four_rad2: f64,
     /// The axis segment from `c + axis·a0` to `c + axis·a1`, for box tests.
     axis_probe: BoxProbe,
 }
@@ -418,6 +422,8 @@ impl Cylinder {
             a0,
             a1,
             rad,
+            axis_abs: [axis.x.abs(), axis.y.abs(), axis.z.abs()],
+            four_rad2: 4.0 * rad * rad,
         }
     }
 
@@ -431,7 +437,7 @@ impl Cylinder {
             d[k] = 0.5 * (lo[k] + hi[k]) - self.c[k];
             let e = 0.5 * (hi[k] - lo[k]);
             mid += d[k] * self.axis[k];
-            half += e * self.axis[k].abs();
+            half += e * self.axis_abs[k];
             r2 += e * e;
         }
         if mid + half < self.a0 || mid - half > self.a1 {
@@ -443,7 +449,7 @@ impl Cylinder {
         }
         // Within `rad` plus the box's half diagonal of the axis: d² ≤ (rad + √r2)².
         let over = d2 - self.rad * self.rad - r2;
-        if over > 0.0 && over * over > 4.0 * self.rad * self.rad * r2 {
+        if over > 0.0 && over * over > self.four_rad2 * r2 {
             return false;
         }
         // The axis segment against the box grown by the radius.
