@@ -110,6 +110,20 @@ pub struct Draft {
     pub isoplanar: Option<super::isoplanar::IsoplanarStats>,
 }
 
+/// Room made for a draft, as a multiple of the CL points the work estimate expects (it
+/// was 0.72 to 1.24 times the draft's moves on the head, the keycap, dome and bumps-hole).
+const DRAFT_ROOM: f64 = 1.3;
+
+/// Room added each time a draft outgrows its room, as a share of its moves: a vector that
+/// doubles holds its old and new arrays at once, three times its moves (the head five-axis
+/// draft grew wasm memory to 48 MB that way; its moves, params and footprints take 28 MB).
+const DRAFT_GROWTH: usize = 4;
+
+/// Room a finished draft keeps for the moves the pipeline adds (lifting balls out of the
+/// surface, splitting turns), as a share of its moves: 1/16 (the head five-axis plan adds
+/// 1.8 %).
+const PATH_HEADROOM: usize = 16;
+
 /// Builds a [`Draft`] move by move.
 pub struct DraftBuilder {
     r: f64,
@@ -125,12 +139,26 @@ impl DraftBuilder {
     pub fn new(model: &Model, opts: &PlanOptions) -> Self {
         let r = opts.tool_radius_mm;
         let top = model.surface.bbox().max[2].max(model.stock.max[2]);
+        let room = (super::budget::estimate(model, opts).cl_points * DRAFT_ROOM)
+            .min(opts.max_cl_points as f64);
+        // NaN (no estimate) gives none.
+        let room = room as usize;
         DraftBuilder {
             r,
             safe_z: top + 2.0 * r + opts.clearance_mm,
-            moves: Vec::new(),
-            params: Vec::new(),
-            footprints: Vec::new(),
+            moves: Vec::with_capacity(room),
+            params: Vec::with_capacity(room),
+            footprints: Vec::with_capacity(room),
+        }
+    }
+
+    /// Room for one more move, grown by a quarter where it is full.
+    fn make_room(&mut self) {
+        if self.moves.len() == self.moves.capacity() {
+            let more = self.moves.len() / DRAFT_GROWTH + 1;
+            self.moves.reserve_exact(more);
+            self.params.reserve_exact(more);
+            self.footprints.reserve_exact(more);
         }
     }
 
@@ -145,6 +173,7 @@ impl DraftBuilder {
     }
 
     fn push(&mut self, kind: MoveKind, p: &SurfacePoint, line: u32, fp: Footprint) {
+        self.make_room();
         self.moves.push(Move {
             kind,
             cc_point: p.cc,
@@ -162,6 +191,7 @@ impl DraftBuilder {
         let Some(last) = self.moves.last().copied() else {
             return;
         };
+        self.make_room();
         self.moves.push(Move {
             kind,
             cl_point: cl,
@@ -211,9 +241,13 @@ impl DraftBuilder {
         forced_retractions: usize,
     ) -> Draft {
         self.retract();
-        // Grown by doubling: give back the unused half.
-        self.moves.shrink_to_fit();
-        self.params.shrink_to_fit();
+        // Give back the room not used, but for what the pipeline adds to the path: a vector
+        // that outgrows its room is copied whole where its block cannot grow in place (in
+        // wasm, where other arrays follow it), and the copy and the old array are held at
+        // once (the head five-axis plan's bridging grew wasm memory by 19 MB that way).
+        let room = self.moves.len() + self.moves.len() / PATH_HEADROOM;
+        self.moves.shrink_to(room);
+        self.params.shrink_to(room);
         self.footprints.shrink_to_fit();
         Draft {
             strategy,

@@ -172,12 +172,18 @@ pub fn finish(
         }
     };
     let mut rounds = 0;
+    // The draft's moves become the path's (what the end halves below need of them is kept
+    // apart); another round takes them back from the path.
+    let along = reach::Along::of(&draft.toolpath.moves);
+    let mut moves = std::mem::take(&mut draft.toolpath.moves);
     let (mut path, air) = loop {
-        let (mut path, origin) = reach::split(&draft, &why);
+        let (mut path, origin) = reach::split_taking(moves, &draft, &why);
         axis::fill_air_axes(&mut path);
         match air::route(model, &mut path, opts, dist) {
             Routed::Done(stats) => break (path, stats),
             Routed::LeaveOut(cuts) => {
+                // The path is as split: its kept moves are the draft's.
+                moves = reach::unsplit(&path, &origin, &along);
                 rounds += 1;
                 if rounds > MAX_ROUTE_ROUNDS {
                     let p = path.moves[cuts[0]].cl_point;
@@ -200,10 +206,10 @@ pub fn finish(
     if !progress(0.85) {
         return Err(Error::Cancelled);
     }
-    // The half footprints at the cuts' ends, the last use of the draft's moves: they go
-    // before the bridging copies the path (on the head at h 0.01 mm, 20 of some 90 MB).
-    let end_halves = reach::cut_end_halves(&draft, &why);
-    draft.toolpath.moves = Vec::new();
+    // The half footprints at the cuts' ends, the last use of the draft's params: they go
+    // before the bridging grows the path.
+    let end_halves = reach::cut_end_halves(&draft, &along, &why);
+    drop(along);
     draft.toolpath.params = Vec::new();
     // 4. Turns of the axis between cut points, checked for the shank and holder.
     axis::bridge_turns(&mut path, &obs, opts, &mut axes);

@@ -85,99 +85,147 @@ pub struct Rest {
 /// rebuilt the same way (straight up and down; [`super::air`] routes them afterwards).
 /// Returns the path and, per move, the draft move it cuts (`u32::MAX` for air moves).
 pub fn split(draft: &Draft, skip: &[Option<Why>]) -> (Toolpath, Vec<u32>) {
+    split_taking(draft.toolpath.moves.clone(), draft, skip)
+}
+
+/// [`split`] with the draft's moves given apart (`moves`; `draft.toolpath.moves` is not
+/// read): the path's moves are written over them, so the path's largest vector is not
+/// held twice (the draft's and the path's side by side were the head five-axis plan's peak,
+/// 34 of 66 MB).
+pub fn split_taking(
+    mut moves: Vec<Move>,
+    draft: &Draft,
+    skip: &[Option<Why>],
+) -> (Toolpath, Vec<u32>) {
     let old = &draft.toolpath;
-    let n = old.moves.len();
-    // Each cut kept costs at most three moves more (retract, rapid, plunge): room for them
-    // all, so the vectors never double.
-    let kept = |i: usize| old.moves[i].kind.on_surface() && skip[i].is_none();
-    let cuts = (0..n)
-        .filter(|&i| kept(i) && (i == 0 || !kept(i - 1)))
-        .count();
-    let room = n + 3 * cuts + 2;
+    let n = moves.len();
     let has_params = old.params.len() == n;
-    let mut out = Emitted {
-        has_params,
-        safe_z: draft.safe_z,
-        moves: Vec::with_capacity(room),
-        params: Vec::with_capacity(if has_params { room } else { 0 }),
-        origin: Vec::with_capacity(room),
+    let param = |i: usize| old.params.get(i).copied().unwrap_or_default();
+    // The kept moves to the front, in order (each lands at or before where it was), with
+    // the draft move each is and whether it starts a cut (its draft predecessor not kept).
+    let mut cut: Vec<u32> = Vec::new();
+    let mut starts: Vec<bool> = Vec::new();
+    let mut before_kept = false;
+    for i in 0..n {
+        let kept = moves[i].kind.on_surface() && skip[i].is_none();
+        if kept {
+            moves[cut.len()] = moves[i];
+            starts.push(!before_kept);
+            cut.push(i as u32);
+        }
+        before_kept = kept;
+    }
+    let kept = cut.len();
+    let cuts = starts.iter().filter(|&&s| s).count();
+    // Each cut comes down from above its first point and goes back up after its last.
+    let len = kept + 2 * cuts;
+    let mut params = vec![[0.0; 2]; if has_params { len } else { 0 }];
+    let mut origin = vec![u32::MAX; len];
+    moves.truncate(kept);
+    moves.reserve_exact(len - kept);
+    if let Some(&filler) = moves.first() {
+        moves.resize(len, filler);
+    }
+    // From the end back, each kept move to its place, the air moves round each cut beside
+    // it: the places written lie above every kept move not yet moved.
+    let safe = |m: &Move, kind: MoveKind| Move {
+        kind,
+        cl_point: Point3::new(m.cl_point.x, m.cl_point.y, draft.safe_z),
+        ..*m
     };
-    // Whether the tool is on the surface at the last move emitted and may go on from there.
-    let mut joined = false;
-    for (i, m) in old.moves.iter().enumerate() {
-        if !m.kind.on_surface() || skip[i].is_some() {
-            joined = false;
+    let mut w = len;
+    let mut put = |moves: &mut [Move], m: Move, q: [f64; 2], o: u32| {
+        w -= 1;
+        moves[w] = m;
+        if has_params {
+            params[w] = q;
+        }
+        origin[w] = o;
+    };
+    if kept > 0 {
+        let last = moves[kept - 1];
+        let q = param(cut[kept - 1] as usize);
+        put(&mut moves, safe(&last, MoveKind::Retract), q, u32::MAX);
+    }
+    for k in (0..kept).rev() {
+        let m = moves[k];
+        let (i, q) = (cut[k], param(cut[k] as usize));
+        if !starts[k] {
+            put(&mut moves, m, q, i);
             continue;
         }
-        let q = old.params.get(i).copied().unwrap_or_default();
-        if joined {
-            out.push(*m, q, i as u32);
-            continue;
-        }
-        // Come down onto this move from the safe plane, leaving the last cut first.
-        out.retract();
-        let above = Move {
-            kind: MoveKind::Rapid,
-            cl_point: Point3::new(m.cl_point.x, m.cl_point.y, draft.safe_z),
-            ..*m
-        };
-        out.push(above, q, u32::MAX);
         let plunge = Move {
             kind: MoveKind::Plunge,
-            ..*m
+            ..m
         };
-        out.push(plunge, q, i as u32);
-        joined = true;
+        put(&mut moves, plunge, q, i);
+        put(&mut moves, safe(&m, MoveKind::Rapid), q, u32::MAX);
+        if k > 0 {
+            let last = moves[k - 1];
+            let q = param(cut[k - 1] as usize);
+            put(&mut moves, safe(&last, MoveKind::Retract), q, u32::MAX);
+        }
     }
-    out.retract();
-    let runs = split_runs(&old.runs, &out.moves, &out.origin);
+    debug_assert_eq!(w, 0);
+    let runs = split_runs(&old.runs, &moves, &origin);
     (
         Toolpath {
             tool_radius_mm: old.tool_radius_mm,
-            moves: out.moves,
+            moves,
             max_predicted_scallop_mm: old.max_predicted_scallop_mm,
             runs,
-            params: if out.has_params {
-                out.params
-            } else {
-                Vec::new()
-            },
+            params,
         },
-        out.origin,
+        origin,
     )
 }
 
-/// The moves [`split`] emits, with their params and origins.
-struct Emitted {
-    has_params: bool,
-    safe_z: f64,
-    moves: Vec<Move>,
-    params: Vec<[f64; 2]>,
-    origin: Vec<u32>,
+/// What the planner needs of a draft move once the path holds the moves it kept: how it
+/// moves and which pass it is on (12 bytes of a move's 88).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Along {
+    pub kind: MoveKind,
+    pub patch: u32,
+    pub line: u32,
 }
 
-impl Emitted {
-    fn push(&mut self, m: Move, q: [f64; 2], origin: u32) {
-        self.moves.push(m);
-        if self.has_params {
-            self.params.push(q);
-        }
-        self.origin.push(origin);
+impl Along {
+    /// Of each move.
+    pub fn of(moves: &[Move]) -> Vec<Along> {
+        moves
+            .iter()
+            .map(|m| Along {
+                kind: m.kind,
+                patch: m.patch,
+                line: m.line,
+            })
+            .collect()
     }
+}
 
-    /// Straight up to the safe plane from the last move, if it is on the surface.
-    fn retract(&mut self) {
-        let Some(last) = self.moves.last().copied().filter(|m| m.kind.on_surface()) else {
-            return;
-        };
-        let q = self.params.last().copied().unwrap_or_default();
-        let up = Move {
-            kind: MoveKind::Retract,
-            cl_point: Point3::new(last.cl_point.x, last.cl_point.y, self.safe_z),
-            ..last
-        };
-        self.push(up, q, u32::MAX);
+/// The draft's moves again, for another [`split_taking`] with more moves left out, from a
+/// `path` it split (`origin` its origins) and `along` (of the draft's moves): each kept move
+/// as the path holds it, its kind as it was; the others only stand in (their kind is theirs;
+/// a split reads no more of a move it does not keep).
+pub fn unsplit(path: &Toolpath, origin: &[u32], along: &[Along]) -> Vec<Move> {
+    let Some(&filler) = path.moves.first() else {
+        return Vec::new();
+    };
+    let mut moves: Vec<Move> = along
+        .iter()
+        .map(|a| Move {
+            kind: a.kind,
+            patch: a.patch,
+            line: a.line,
+            ..filler
+        })
+        .collect();
+    for (m, &o) in path.moves.iter().zip(origin) {
+        if let Some(d) = moves.get_mut(o as usize) {
+            *d = Move { kind: d.kind, ..*m };
+        }
     }
+    moves
 }
 
 /// The runs of the draft over the split path: each keeps the moves it had that were kept;
@@ -948,9 +996,13 @@ impl Sets {
 /// footprint towards the left-out point (which the feed on to that point would have cut) is
 /// rest area too, with that point's reason: over it the ball's sphere alone leaves material
 /// growing with the distance from the point (head, three-axis, r 0.5 mm: 0.17 mm at the far
-/// corner of such a half, for a 0.05 mm scallop). `skip` has one entry per draft move.
-pub fn cut_end_halves(draft: &Draft, skip: &[Option<Why>]) -> Vec<(Footprint, Why)> {
-    let moves = &draft.toolpath.moves;
+/// corner of such a half, for a 0.05 mm scallop). `moves` ([`Along::of` the draft's moves) and
+/// `skip` have one entry per draft move.
+pub fn cut_end_halves(
+    draft: &Draft,
+    moves: &[Along],
+    skip: &[Option<Why>],
+) -> Vec<(Footprint, Why)> {
     let params = &draft.toolpath.params;
     if params.len() != moves.len() || skip.len() != moves.len() {
         return Vec::new();
@@ -1231,6 +1283,164 @@ mod tests {
             tool_axis: Vector3::z(),
             patch: 0,
             line: 0,
+        }
+    }
+
+    /// The split as first written, move by move in path order (the second method for
+    /// [`split_taking`], which works in place from the end back).
+    fn split_in_order(draft: &Draft, skip: &[Option<Why>]) -> (Toolpath, Vec<u32>) {
+        let old = &draft.toolpath;
+        let has_params = old.params.len() == old.moves.len();
+        let (mut moves, mut params, mut origin) = (Vec::new(), Vec::new(), Vec::new());
+        let mut push = |moves: &mut Vec<Move>, m: Move, q: [f64; 2], o: u32| {
+            moves.push(m);
+            if has_params {
+                params.push(q);
+            }
+            origin.push(o);
+        };
+        let mut last_q = [0.0; 2];
+        let mut joined = false;
+        for (i, m) in old.moves.iter().enumerate() {
+            if !m.kind.on_surface() || skip[i].is_some() {
+                joined = false;
+                continue;
+            }
+            let q = old.params.get(i).copied().unwrap_or_default();
+            if joined {
+                push(&mut moves, *m, q, i as u32);
+                last_q = q;
+                continue;
+            }
+            if let Some(&last) = moves.last() {
+                let up = Move {
+                    kind: MoveKind::Retract,
+                    cl_point: Point3::new(last.cl_point.x, last.cl_point.y, draft.safe_z),
+                    ..last
+                };
+                push(&mut moves, up, last_q, u32::MAX);
+            }
+            let above = Move {
+                kind: MoveKind::Rapid,
+                cl_point: Point3::new(m.cl_point.x, m.cl_point.y, draft.safe_z),
+                ..*m
+            };
+            push(&mut moves, above, q, u32::MAX);
+            let plunge = Move {
+                kind: MoveKind::Plunge,
+                ..*m
+            };
+            push(&mut moves, plunge, q, i as u32);
+            last_q = q;
+            joined = true;
+        }
+        if let Some(&last) = moves.last() {
+            let up = Move {
+                kind: MoveKind::Retract,
+                cl_point: Point3::new(last.cl_point.x, last.cl_point.y, draft.safe_z),
+                ..last
+            };
+            push(&mut moves, up, last_q, u32::MAX);
+        }
+        let runs = split_runs(&old.runs, &moves, &origin);
+        let path = Toolpath {
+            tool_radius_mm: old.tool_radius_mm,
+            moves,
+            max_predicted_scallop_mm: old.max_predicted_scallop_mm,
+            runs,
+            params,
+        };
+        (path, origin)
+    }
+
+    /// A draft of `n` moves of every kind in random order over two patches' runs, with
+    /// random params (or none) and random points left out.
+    fn random_draft(next: &mut impl FnMut() -> f64, n: usize) -> (Draft, Vec<Option<Why>>) {
+        use MoveKind::*;
+        let kinds = [Feed, Feed, Feed, Link, Plunge, Retract, Rapid];
+        let moves: Vec<Move> = (0..n)
+            .map(|i| Move {
+                kind: kinds[(next() * kinds.len() as f64) as usize],
+                cc_point: Point3::new(next(), next(), next()),
+                cl_point: Point3::new(next(), next(), next()),
+                tool_axis: Vector3::new(next(), next(), 1.0).normalize(),
+                patch: (2 * i / n.max(1)) as u32,
+                line: (next() * 4.0) as u32,
+            })
+            .collect();
+        let params = if next() < 0.8 {
+            (0..n).map(|_| [next(), next()]).collect()
+        } else {
+            Vec::new()
+        };
+        let run = |patch: u32, first_move: usize, last_move: usize| PatchRun {
+            patch,
+            start_corner: 0,
+            finish_corner: 2,
+            crossfeed: crate::plan::corners::Crossfeed::U,
+            passes: 3,
+            scallop_used_mm: 0.01,
+            retract_before: true,
+            first_move,
+            last_move,
+        };
+        let half = n / 2;
+        let runs = if n > 1 {
+            vec![run(0, 0, half - 1), run(1, half, n - 1)]
+        } else {
+            Vec::new()
+        };
+        let share = next() * 0.5;
+        let skip = (0..n)
+            .map(|_| (next() < share).then_some(Why::ToolHits))
+            .collect();
+        let draft = Draft {
+            strategy: "test",
+            toolpath: Toolpath {
+                tool_radius_mm: 0.5,
+                moves,
+                max_predicted_scallop_mm: 0.004,
+                runs,
+                params,
+            },
+            footprints: vec![Footprint::NONE; n],
+            safe_z: 10.0,
+            forced_retractions: 0,
+            isfc: None,
+            isoplanar: None,
+        };
+        (draft, skip)
+    }
+
+    /// Split in place equals split in path order on 400 random drafts (up to 60 moves, up to
+    /// half of them left out, with and without params), and split again from the path
+    /// ([`unsplit`]) with more points left out equals splitting the draft with all of them.
+    #[test]
+    fn split_in_place_equals_split_in_order_and_splits_again_from_its_path() {
+        let mut next = crate::testing::uniform(0x5eed_5b11);
+        for case in 0..400 {
+            let n = (next() * 60.0) as usize;
+            let (draft, skip) = random_draft(&mut next, n);
+            let (want, want_origin) = split_in_order(&draft, &skip);
+            let (got, origin) = split(&draft, &skip);
+            assert_eq!(got.moves, want.moves, "case {case}: moves");
+            assert_eq!(got.params, want.params, "case {case}: params");
+            assert_eq!(got.runs, want.runs, "case {case}: runs");
+            assert_eq!(origin, want_origin, "case {case}: origins");
+            // More left out, among the points kept.
+            let mut more = skip.clone();
+            for &o in origin.iter().filter(|&&o| o != u32::MAX) {
+                if next() < 0.3 {
+                    more[o as usize] = Some(Why::NoWayOut);
+                }
+            }
+            let again = unsplit(&got, &origin, &Along::of(&draft.toolpath.moves));
+            let (got2, origin2) = split_taking(again, &draft, &more);
+            let (want2, want_origin2) = split_in_order(&draft, &more);
+            assert_eq!(got2.moves, want2.moves, "case {case}: moves again");
+            assert_eq!(got2.params, want2.params, "case {case}: params again");
+            assert_eq!(got2.runs, want2.runs, "case {case}: runs again");
+            assert_eq!(origin2, want_origin2, "case {case}: origins again");
         }
     }
 
