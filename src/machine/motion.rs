@@ -375,7 +375,7 @@ pub fn segment_times(segs: &[Segment], rotary_feed_deg_min: f64, d: &Dynamics) -
 /// [`segment_times`] of the `n` segments `seg(k)` makes on demand: a long path's segments
 /// and whole profiles need not be held at once, only each move's [`Motion`] and a speed per
 /// corner.
-pub fn segment_times_by(
+fn segment_times_by(
     n: usize,
     seg: impl Fn(usize) -> Segment,
     rotary_feed_deg_min: f64,
@@ -386,10 +386,6 @@ pub fn segment_times_by(
     // and n are the start and end (stopped). The passes below need only the motions.
     let mut w = vec![0.0; n + 1];
     let mut m: Vec<Motion> = Vec::with_capacity(n);
-    let mut before = (n > 0).then(|| profile(0));
-    if let Some(a) = &before {
-        m.push(a.motion);
-    }
     let cap = |p: &Profile| {
         if p.motion.to_path > 0.0 {
             p.motion.top / p.motion.to_path
@@ -397,10 +393,12 @@ pub fn segment_times_by(
             0.0
         }
     };
-    for k in 1..n {
+    let mut before: Option<Profile> = None;
+    for k in 0..n {
         let b = profile(k);
-        let a = before.as_ref().expect("set for every k below n");
-        w[k] = corner_speed(a, &b, d).min(cap(a)).min(cap(&b));
+        if let Some(a) = &before {
+            w[k] = corner_speed(a, &b, d).min(cap(a)).min(cap(&b));
+        }
         m.push(b.motion);
         before = Some(b);
     }

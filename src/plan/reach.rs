@@ -206,7 +206,8 @@ impl Along {
 /// The draft's moves again, for another [`split_taking`] with more moves left out, from a
 /// `path` it split (`origin` its origins) and `along` (of the draft's moves): each kept move
 /// as the path holds it, its kind as it was; the others only stand in (their kind is theirs;
-/// a split reads no more of a move it does not keep).
+/// a split reads no more of a move it does not keep). None from a path without moves, which
+/// kept none.
 pub fn unsplit(path: &Toolpath, origin: &[u32], along: &[Along]) -> Vec<Move> {
     let Some(&filler) = path.moves.first() else {
         return Vec::new();
@@ -1299,6 +1300,11 @@ mod tests {
             }
             origin.push(o);
         };
+        let up = |last: Move| Move {
+            kind: MoveKind::Retract,
+            cl_point: Point3::new(last.cl_point.x, last.cl_point.y, draft.safe_z),
+            ..last
+        };
         let mut last_q = [0.0; 2];
         let mut joined = false;
         for (i, m) in old.moves.iter().enumerate() {
@@ -1313,12 +1319,7 @@ mod tests {
                 continue;
             }
             if let Some(&last) = moves.last() {
-                let up = Move {
-                    kind: MoveKind::Retract,
-                    cl_point: Point3::new(last.cl_point.x, last.cl_point.y, draft.safe_z),
-                    ..last
-                };
-                push(&mut moves, up, last_q, u32::MAX);
+                push(&mut moves, up(last), last_q, u32::MAX);
             }
             let above = Move {
                 kind: MoveKind::Rapid,
@@ -1335,12 +1336,7 @@ mod tests {
             joined = true;
         }
         if let Some(&last) = moves.last() {
-            let up = Move {
-                kind: MoveKind::Retract,
-                cl_point: Point3::new(last.cl_point.x, last.cl_point.y, draft.safe_z),
-                ..last
-            };
-            push(&mut moves, up, last_q, u32::MAX);
+            push(&mut moves, up(last), last_q, u32::MAX);
         }
         let runs = split_runs(&old.runs, &moves, &origin);
         let path = Toolpath {
