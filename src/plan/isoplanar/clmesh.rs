@@ -295,6 +295,12 @@ fn along_into(side: u8, su: Vector3, sv: Vector3) -> (Vector3, Vector3) {
     }
 }
 
+/// The angle (radians) between unit normals `na` and `nb`, by the arctangent of its sine
+/// over its cosine (accurate for small turns, where the arccosine of the dot product is not).
+fn turn_between(na: &Vector3, nb: &Vector3) -> f64 {
+    na.cross(nb).norm().atan2(na.dot(nb))
+}
+
 /// The unit normal a turn `k` (0 to 1) of the way from unit normal `na` to `nb` about their
 /// common perpendicular (exactly `na` at 0 and `nb` at 1).
 pub fn pivot_normal(na: &Vector3, nb: &Vector3, k: f64) -> Vector3 {
@@ -304,7 +310,7 @@ pub fn pivot_normal(na: &Vector3, nb: &Vector3, k: f64) -> Vector3 {
     if k >= 1.0 {
         return *nb;
     }
-    let theta = na.cross(nb).norm().atan2(na.dot(nb));
+    let theta = turn_between(na, nb);
     let s = theta.sin();
     if !(s > 0.0) {
         return (*na * (1.0 - k) + *nb * k)
@@ -478,7 +484,7 @@ fn pivot_strips(
             }
             let nb = unit_normal(&su_b, &sv_b)? * side;
             let (_, into_b) = along_into(sb, su_b, sv_b);
-            let turn = na.cross(&nb).norm().atan2(na.dot(&nb));
+            let turn = turn_between(&na, &nb);
             // Convex: each patch's normal leans away from the other patch; concave: towards.
             let (lean_a, lean_b) = (nb.dot(&into_a), na.dot(&into_b));
             let convex = lean_a < 0.0 && lean_b < 0.0;
