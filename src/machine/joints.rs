@@ -115,14 +115,10 @@ struct State {
     back: u32,
 }
 
-/// What the way back needs of a state once its layer is done (the linear joints follow
-/// from the rotaries and the move's tip): 24 bytes, where keeping whole states took 64 (16 MB
-/// on the head's 197 571 moves).
-#[derive(Debug, Clone, Copy)]
-struct Kept {
-    rotary_deg: [f64; 2],
-    back: u32,
-}
+/// States at most one move may have: a state's way back ([`solve_rotaries_by`]) is kept in
+/// two bytes. A layer holds one state per orientation branch and turn the limits allow,
+/// a few on any machine (limits of ±23 000° on both rotaries would be needed to exceed it).
+const MAX_LAYER_STATES: usize = u16::MAX as usize;
 
 /// True when `a` and `b` are the same state (endless axes up to whole turns).
 fn same_state(machine: &Machine, a: &State, b: &State) -> bool {
@@ -203,18 +199,41 @@ pub fn solve_by(
     n: usize,
     pose: impl Fn(usize) -> PoseRequest,
 ) -> Result<Vec<Joints>> {
+    Ok(solve_rotaries_by(machine, n, &pose)?
+        .into_iter()
+        .enumerate()
+        .map(|(i, rotary_deg)| Joints {
+            xyz_mm: machine.linear_joints(&pose(i).tip, rotary_deg),
+            rotary_deg,
+        })
+        .collect())
+}
+
+/// The rotary angles (degrees) [`solve_by`] chooses at each move, without the linear joints,
+/// which follow from them and the move's tip ([`Machine::linear_joints`]): what a whole
+/// path's timing needs to hold.
+///
+/// The way back keeps 20 bytes per state (the rotaries, and the state it comes from in two
+/// bytes) and two per move (its layer's size), where whole states took 64 (16 MB on the
+/// head's 197 571 moves) and then, with the layers' starts, 32: in wasm a block of that size
+/// did not fit the room the plan had freed, and grew the memory by 7.6 MB.
+pub fn solve_rotaries_by(
+    machine: &Machine,
+    n: usize,
+    pose: impl Fn(usize) -> PoseRequest,
+) -> Result<Vec<[f64; 2]>> {
     let home = State {
         rotary_deg: [0.0; 2],
         branch: None,
         travel_deg: 0.0,
         back: 0,
     };
-    // The layers one after another in one vector (layer `i` is `kept[starts[i]..starts[i +
-    // 1]]`): a vector per move took its least capacity of four states, 256 bytes, for the one
-    // or two most moves have (50 MB of the head's 197 571 moves).
-    let mut kept: Vec<Kept> = Vec::with_capacity(n + n / 4);
-    let mut starts: Vec<usize> = Vec::with_capacity(n + 1);
-    starts.push(0);
+    // The layers one after another (layer `i` is `sizes[i]` states, ending where layer `i
+    // + 1` starts): a vector per move took its least capacity of four states, 256 bytes,
+    // for the one or two most moves have (50 MB of the head's 197 571 moves).
+    let mut rotary_deg: Vec<[f64; 2]> = Vec::with_capacity(n + n / 4);
+    let mut back: Vec<u16> = Vec::with_capacity(n + n / 4);
+    let mut sizes: Vec<u16> = Vec::with_capacity(n);
     let (mut from, mut next): (Vec<State>, Vec<State>) = (vec![home], Vec::new());
     let mut before: Option<PoseRequest> = None;
     for i in 0..n {
@@ -245,39 +264,52 @@ pub fn solve_by(
         if next.is_empty() {
             return Err(dead_end(machine, &p, i, &from));
         }
-        kept.extend(next.iter().map(|s| Kept {
-            rotary_deg: s.rotary_deg,
-            back: s.back,
-        }));
-        starts.push(kept.len());
+        let Ok(size) = u16::try_from(next.len()) else {
+            return Err(Error::Machine {
+                location: format!("move {i}"),
+                message: format!(
+                    "the limits of machine `{}` ({}) allow more than {MAX_LAYER_STATES} ways to turn the rotaries to one tool axis; give a rotary that turns without end no limits",
+                    machine.name,
+                    limits_text(machine)
+                ),
+            });
+        };
+        sizes.push(size);
+        rotary_deg.extend(next.iter().map(|s| s.rotary_deg));
+        // An index into the previous layer, which held at most MAX_LAYER_STATES states.
+        back.extend(next.iter().map(|s| s.back as u16));
         std::mem::swap(&mut from, &mut next);
         before = Some(p);
     }
-    let Some(last) = n.checked_sub(1) else {
+    // `from` is the last layer, with its travel.
+    let Some(mut k) =
+        (0..from.len()).min_by(|&a, &b| from[a].travel_deg.total_cmp(&from[b].travel_deg))
+    else {
         return Ok(Vec::new());
     };
-    let layer = |i: usize| &kept[starts[i]..starts[i + 1]];
-    // `from` is the last layer, with its travel.
-    let mut k = (0..from.len())
-        .min_by(|&a, &b| from[a].travel_deg.total_cmp(&from[b].travel_deg))
-        .expect("a layer is never empty");
-    debug_assert_eq!(from.len(), layer(last).len());
-    let mut out = vec![
-        Joints {
-            xyz_mm: [0.0; 3],
-            rotary_deg: [0.0; 2],
-        };
-        n
-    ];
+    // The way back, from the last layer to the first. The state chosen in layer `i` is
+    // noted in place of its first state's way back, which no later step reads (each step
+    // reads a way back in its own layer).
+    let mut end = rotary_deg.len();
     for i in (0..n).rev() {
-        let s = layer(i)[k];
-        out[i] = Joints {
-            xyz_mm: machine.linear_joints(&pose(i).tip, s.rotary_deg),
-            rotary_deg: s.rotary_deg,
-        };
-        k = s.back as usize;
+        let start = end - sizes[i] as usize;
+        let chosen = k;
+        k = back[start + chosen] as usize;
+        back[start] = chosen as u16;
+        end = start;
     }
-    Ok(out)
+    // Then each chosen state to its move's place, in move order: the state chosen at move
+    // `i` lies at or after `i` (every layer holds at least one state), so no place is
+    // written before the state it holds is read.
+    let mut start = 0;
+    for i in 0..n {
+        rotary_deg[i] = rotary_deg[start + back[start] as usize];
+        start += sizes[i] as usize;
+    }
+    drop((back, sizes));
+    rotary_deg.truncate(n);
+    rotary_deg.shrink_to_fit();
+    Ok(rotary_deg)
 }
 
 /// Why no allowed solution exists at move `i`, said from the cheapest state before it.

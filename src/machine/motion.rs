@@ -30,6 +30,7 @@ use super::joints;
 use super::kinematics::Machine;
 use crate::plan::{PlanOptions, Toolpath};
 use serde::{Deserialize, Serialize};
+use std::cell::Cell;
 
 /// Seconds per minute.
 const S_PER_MIN: f64 = 60.0;
@@ -424,9 +425,13 @@ fn segment_times_by(
         let exit = reach(entry, mv.p, w[k + 1] * mv.to_path, mv.accel, mv.jerk);
         w[k + 1] = w[k + 1].min(exit / mv.to_path);
     }
-    (0..n)
-        .map(|k| move_time(&m[k], w[k] * m[k].to_path, w[k + 1] * m[k].to_path))
-        .collect()
+    // Each move's time over its entry speed, which no later move reads: the corner speeds'
+    // vector becomes the times' (one place to spare).
+    for k in 0..n {
+        w[k] = move_time(&m[k], w[k] * m[k].to_path, w[k + 1] * m[k].to_path);
+    }
+    w.truncate(n);
+    w
 }
 
 /// How long a path takes on a machine.
@@ -451,22 +456,32 @@ impl PathTimes {
 /// path, the tool axis' turn stands in for the rotaries'.
 pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> PathTimes {
     let n = path.moves.len();
-    let joints = if machine.rotaries.is_empty() {
+    let rotaries = if machine.rotaries.is_empty() {
         None
     } else {
-        joints::solve_by(machine, n, |i| joints::path_request(path, i)).ok()
+        joints::solve_rotaries_by(machine, n, |i| joints::path_request(path, i)).ok()
     };
-    let from_joints = machine.rotaries.is_empty() || joints.is_some();
+    let from_joints = machine.rotaries.is_empty() || rotaries.is_some();
+    let last_linear: Cell<Option<(usize, [f64; 3])>> = Cell::new(None);
     let seg = |k: usize| {
         let i = k + 1;
         let (a, b) = (&path.moves[i - 1], &path.moves[i]);
-        let tip = joints::tip(path, i) - joints::tip(path, i - 1);
-        let (linear_mm, rotary_deg) = match &joints {
-            Some(j) => {
-                let (p, q) = (&j[i - 1], &j[i]);
+        let (p, q) = (joints::tip(path, i - 1), joints::tip(path, i));
+        let tip = q - p;
+        let (linear_mm, rotary_deg) = match &rotaries {
+            Some(r) => {
+                let (r0, r1) = (r[i - 1], r[i]);
+                // The segments come in order: the linear joints at this one's start are the
+                // last one's end.
+                let p = match last_linear.get() {
+                    Some((j, xyz)) if j == i - 1 => xyz,
+                    _ => machine.linear_joints(&p, r0),
+                };
+                let q = machine.linear_joints(&q, r1);
+                last_linear.set(Some((i, q)));
                 (
-                    [0, 1, 2].map(|k| q.xyz_mm[k] - p.xyz_mm[k]),
-                    [0, 1].map(|k| q.rotary_deg[k] - p.rotary_deg[k]),
+                    [0, 1, 2].map(|k| q[k] - p[k]),
+                    [0, 1].map(|k| r1[k] - r0[k]),
                 )
             }
             None => {
@@ -481,15 +496,16 @@ pub fn path_times(path: &Toolpath, opts: &PlanOptions, machine: &Machine) -> Pat
             feed_mm_min: opts.feed_for(b.kind),
         }
     };
-    let mut seconds = Vec::with_capacity(n);
+    let mut seconds = Vec::new();
     if n > 0 {
-        seconds.push(0.0);
-        seconds.extend(segment_times_by(
+        seconds = segment_times_by(
             n - 1,
             seg,
             machine.max_rotary_feed_deg_min,
             &machine.dynamics,
-        ));
+        );
+        // Within the capacity `segment_times_by` leaves.
+        seconds.insert(0, 0.0);
     }
     PathTimes {
         seconds,
