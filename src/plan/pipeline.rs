@@ -146,6 +146,13 @@ pub fn finish(
         &mut |f| progress(GOUGE_PROGRESS + TIGHT_PROGRESS * f),
     )
     .ok_or(Error::Cancelled)?;
+    // And points whose lifted ball leaves more than the scallop there: the material left is
+    // not needed past this.
+    let tight: Vec<bool> = tight
+        .into_iter()
+        .zip(left)
+        .map(|(t, l)| t || l > opts.scallop_mm)
+        .collect();
     if !progress(GOUGE_PROGRESS + TIGHT_PROGRESS) {
         return Err(Error::Cancelled);
     }
@@ -218,9 +225,8 @@ pub fn finish(
     //    leaves above the scallop.
     let mut rest_fps: Vec<(Footprint, Why)> = (0..n)
         .filter_map(|i| {
-            let tight = tight[i] || left[i] > opts.scallop_mm;
             why[i]
-                .or(tight.then_some(Why::TooTight))
+                .or(tight[i].then_some(Why::TooTight))
                 .map(|w| (draft.footprints[i], w))
         })
         .collect();

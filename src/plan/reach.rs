@@ -103,20 +103,24 @@ pub fn split_taking(
     let param = |i: usize| old.params.get(i).copied().unwrap_or_default();
     // The kept moves to the front, in order (each lands at or before where it was), with
     // the draft move each is and whether it starts a cut (its draft predecessor not kept).
-    let mut cut: Vec<u32> = Vec::new();
-    let mut starts: Vec<bool> = Vec::new();
-    let mut before_kept = false;
+    let keep = |m: &Move, i: usize| m.kind.on_surface() && skip[i].is_none();
+    let mut cut: Vec<u32> = Vec::with_capacity(
+        moves
+            .iter()
+            .enumerate()
+            .filter(|&(i, m)| keep(m, i))
+            .count(),
+    );
     for i in 0..n {
-        let kept = moves[i].kind.on_surface() && skip[i].is_none();
-        if kept {
+        if keep(&moves[i], i) {
             moves[cut.len()] = moves[i];
-            starts.push(!before_kept);
             cut.push(i as u32);
         }
-        before_kept = kept;
     }
     let kept = cut.len();
-    let cuts = starts.iter().filter(|&&s| s).count();
+    // Kept move `k` starts a cut where its draft predecessor was not kept.
+    let starts = |k: usize| k == 0 || cut[k - 1] + 1 != cut[k];
+    let cuts = (0..kept).filter(|&k| starts(k)).count();
     // Each cut comes down from above its first point and goes back up after its last.
     let len = kept + 2 * cuts;
     let mut params = vec![[0.0; 2]; if has_params { len } else { 0 }];
@@ -150,7 +154,7 @@ pub fn split_taking(
     for k in (0..kept).rev() {
         let m = moves[k];
         let (i, q) = (cut[k], param(cut[k] as usize));
-        if !starts[k] {
+        if !starts(k) {
             put(&mut moves, m, q, i);
             continue;
         }

@@ -110,26 +110,83 @@ impl OldMoves<'_> {
 /// Interval at which the tool axis is sampled in time for its angular acceleration (s).
 pub const ACCELERATION_SAMPLE_S: f64 = 0.05;
 
-/// The axis at time `t` of a run of `(time, axis)` points (times increasing), turning at a
-/// constant rate between them.
-fn axis_at(run: &[(f64, Vector3)], t: f64) -> Vector3 {
-    let k = run.partition_point(|&(s, _)| s <= t);
-    if k == 0 {
-        return run[0].1;
+/// One run of cutting moves sampled for [`Toolpath::max_axis_acceleration`]: the tool axis
+/// at times `k × ACCELERATION_SAMPLE_S` from the run's start, turning at a steady rate
+/// (spherical interpolation) through each move, the last three samples, and the largest
+/// acceleration so far.
+#[derive(Default)]
+struct RunSamples {
+    /// Time (s) and axis of the run's last point; `None` between runs.
+    last: Option<(f64, Vector3)>,
+    /// Index of the next sample.
+    next: usize,
+    /// The last samples, newest last (`count` of them, at most three).
+    window: [Vector3; 3],
+    count: usize,
+    /// Largest angular acceleration found (deg/s²).
+    largest: f64,
+}
+
+impl RunSamples {
+    /// A move of the run from axis `from` (the run's first point, if it has none yet) to
+    /// `to`, lasting `took` seconds (none when 0: the next move starts at the same time).
+    fn add(&mut self, from: Vector3, took: f64, to: Vector3) {
+        let (s0, u) = *self.last.get_or_insert((0.0, from));
+        if took > 0.0 {
+            let s1 = s0 + took;
+            // The samples within [s0, s1).
+            loop {
+                let t = self.next as f64 * ACCELERATION_SAMPLE_S;
+                if t >= s1 {
+                    break;
+                }
+                self.sample(slerp(&u, &to, (t - s0) / (s1 - s0)));
+            }
+            self.last = Some((s1, to));
+        }
     }
-    if k == run.len() {
-        return run[k - 1].1;
+
+    /// Ends the run: the samples up to its end take its last axis.
+    fn finish(&mut self) {
+        if let Some((end, v)) = self.last.take() {
+            while self.next as f64 * ACCELERATION_SAMPLE_S <= end {
+                self.sample(v);
+            }
+        }
+        self.next = 0;
+        self.count = 0;
     }
-    let ((s0, u), (s1, v)) = (run[k - 1], run[k]);
-    let f = (t - s0) / (s1 - s0);
-    let angle = u.angle(&v);
+
+    fn sample(&mut self, axis: Vector3) {
+        self.next += 1;
+        self.window.rotate_left(1);
+        self.window[2] = axis;
+        self.count = (self.count + 1).min(3);
+        if self.count < 3 {
+            return;
+        }
+        let dt = ACCELERATION_SAMPLE_S;
+        let velocity = |u: &Vector3, v: &Vector3| {
+            u.cross(v)
+                .try_normalize(f64::MIN_POSITIVE)
+                .map_or(Vector3::zeros(), |k| k * (u.angle(v).to_degrees() / dt))
+        };
+        let w = &self.window;
+        let a = (velocity(&w[1], &w[2]) - velocity(&w[0], &w[1])).norm() / dt;
+        self.largest = self.largest.max(a);
+    }
+}
+
+/// The unit vector a share `f` of the way from `u` to `v` on the great circle through them.
+fn slerp(u: &Vector3, v: &Vector3, f: f64) -> Vector3 {
+    let angle = u.angle(v);
     if angle < 1e-12 {
-        return u;
+        return *u;
     }
     let sin = angle.sin();
     if sin < 1e-12 {
         // Opposite axes: no defined way round; the nearer end.
-        return if f < 0.5 { u } else { v };
+        return if f < 0.5 { *u } else { *v };
     }
     u * (((1.0 - f) * angle).sin() / sin) + v * ((f * angle).sin() / sin)
 }
@@ -418,52 +475,26 @@ impl Toolpath {
     /// axis is sampled every [`ACCELERATION_SAMPLE_S`] and the change of its angular
     /// velocity between samples taken over that time (so a jump in turning rate counts as
     /// spread over one sample interval, as a machine's servo ramps it).
+    ///
+    /// The samples are taken as the moves come, three kept at a time: a run's points and
+    /// samples held whole took 6 MB on the head five-axis, enough to grow the page's wasm
+    /// memory by 8 MB.
     pub fn max_axis_acceleration(&self, feed_mm_min: f64, rotary_feed_deg_min: f64) -> f64 {
-        let dt = ACCELERATION_SAMPLE_S;
-        let mut largest: f64 = 0.0;
-        // Axes of the current run at uniform times: (time, axis) of its points.
-        let mut run: Vec<(f64, Vector3)> = Vec::new();
-        let mut finish = |run: &mut Vec<(f64, Vector3)>| {
-            let Some(&(end, _)) = run.last() else {
-                return;
-            };
-            let samples: Vec<Vector3> = (0..=(end / dt).floor() as usize)
-                .map(|k| axis_at(run, k as f64 * dt))
-                .collect();
-            let velocity = |u: &Vector3, v: &Vector3| {
-                u.cross(v)
-                    .try_normalize(f64::MIN_POSITIVE)
-                    .map_or(Vector3::zeros(), |k| k * (u.angle(v).to_degrees() / dt))
-            };
-            for w in samples.windows(3) {
-                let a = (velocity(&w[1], &w[2]) - velocity(&w[0], &w[1])).norm() / dt;
-                largest = largest.max(a);
-            }
-            run.clear();
-        };
+        let mut run = RunSamples::default();
         for i in 1..self.moves.len() {
             let (a, b) = (&self.moves[i - 1], &self.moves[i]);
             if !(a.kind.on_surface() && matches!(b.kind, MoveKind::Feed | MoveKind::Link)) {
-                finish(&mut run);
+                run.finish();
                 continue;
             }
             let turn = a.tool_axis.angle(&b.tool_axis).to_degrees();
             let took = ((b.cl_point - a.cl_point).norm() / feed_mm_min)
                 .max(turn / rotary_feed_deg_min)
                 * 60.0;
-            let t0 = match run.last() {
-                Some(&(t, _)) => t,
-                None => {
-                    run.push((0.0, a.tool_axis));
-                    0.0
-                }
-            };
-            if took > 0.0 {
-                run.push((t0 + took, b.tool_axis));
-            }
+            run.add(a.tool_axis, took, b.tool_axis);
         }
-        finish(&mut run);
-        largest
+        run.finish();
+        run.largest
     }
 
     /// Lengths, counts and time estimate. `feed` and `plunge_feed` in mm/min.
@@ -595,6 +626,106 @@ mod tests {
             runs.push((index[r.first_move].0, index[r.last_move].1));
         }
         (moves, params, runs)
+    }
+
+    /// [`Toolpath::max_axis_acceleration`] as it was first written, the second method: each
+    /// run's points held whole, and the axis at each sample time found among them.
+    fn max_axis_acceleration_whole_runs(path: &Toolpath, feed: f64, rotary: f64) -> f64 {
+        let dt = ACCELERATION_SAMPLE_S;
+        let axis_at = |run: &[(f64, Vector3)], t: f64| {
+            let k = run.partition_point(|&(s, _)| s <= t);
+            if k == run.len() {
+                return run[k - 1].1;
+            }
+            let ((s0, u), (s1, v)) = (run[k - 1], run[k]);
+            slerp(&u, &v, (t - s0) / (s1 - s0))
+        };
+        let velocity = |u: &Vector3, v: &Vector3| {
+            u.cross(v)
+                .try_normalize(f64::MIN_POSITIVE)
+                .map_or(Vector3::zeros(), |k| k * (u.angle(v).to_degrees() / dt))
+        };
+        let mut largest: f64 = 0.0;
+        let mut runs: Vec<Vec<(f64, Vector3)>> = vec![Vec::new()];
+        for w in path.moves.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            if !(a.kind.on_surface() && matches!(b.kind, MoveKind::Feed | MoveKind::Link)) {
+                runs.push(Vec::new());
+                continue;
+            }
+            let run = runs.last_mut().unwrap();
+            let took = ((b.cl_point - a.cl_point).norm() / feed)
+                .max(a.tool_axis.angle(&b.tool_axis).to_degrees() / rotary)
+                * 60.0;
+            if run.is_empty() {
+                run.push((0.0, a.tool_axis));
+            }
+            if took > 0.0 {
+                run.push((run.last().unwrap().0 + took, b.tool_axis));
+            }
+        }
+        for run in runs.iter().filter(|r| !r.is_empty()) {
+            let end = run.last().unwrap().0;
+            let samples: Vec<Vector3> = (0..=(end / dt).floor() as usize)
+                .map(|k| axis_at(run, k as f64 * dt))
+                .collect();
+            for w in samples.windows(3) {
+                let a = (velocity(&w[1], &w[2]) - velocity(&w[0], &w[1])).norm() / dt;
+                largest = largest.max(a);
+            }
+        }
+        largest
+    }
+
+    #[test]
+    fn axis_acceleration_sampled_as_the_moves_come_equals_sampling_whole_runs() {
+        // Random paths: cutting runs broken by rapids and plunges, moves of random length
+        // (some none) and turn, some turns slowed by the rotary feed.
+        let mut rnd = crate::testing::uniform(19u64);
+        let mut seen = 0;
+        for trial in 0..200 {
+            let n = 2 + (rnd() * 120.0) as usize;
+            let mut p = Point3::origin();
+            let mut moves = Vec::with_capacity(n);
+            for _ in 0..n {
+                let kind = match rnd() {
+                    x if x < 0.05 => MoveKind::Rapid,
+                    x if x < 0.1 => MoveKind::Plunge,
+                    x if x < 0.2 => MoveKind::Link,
+                    _ => MoveKind::Feed,
+                };
+                if trial % 2 == 1 {
+                    // Moves of whole sample intervals at 600 mm/min (0.5 mm: 0.05 s), so
+                    // that sample times meet the points' times.
+                    p.x += 0.5 * (rnd() * 4.0).floor();
+                } else if rnd() > 0.1 {
+                    p += Vector3::new(rnd() - 0.5, rnd() - 0.5, 0.1 * rnd()) * 3.0;
+                }
+                let (tilt, turn) = (rnd() * 0.6, rnd() * std::f64::consts::TAU);
+                moves.push(Move {
+                    kind,
+                    cc_point: p,
+                    cl_point: p,
+                    tool_axis: Vector3::new(
+                        tilt.sin() * turn.cos(),
+                        tilt.sin() * turn.sin(),
+                        tilt.cos(),
+                    ),
+                    patch: 0,
+                    line: 0,
+                });
+            }
+            let path = Toolpath::new(1.0, moves);
+            let (feed, rotary) = match trial % 2 {
+                1 => (600.0, 1e9),
+                _ => (600.0 + 2000.0 * rnd(), [1200.0, 6000.0, 36000.0][trial % 3]),
+            };
+            let a = path.max_axis_acceleration(feed, rotary);
+            let b = max_axis_acceleration_whole_runs(&path, feed, rotary);
+            assert_eq!(a.to_bits(), b.to_bits(), "trial {trial}: {a} against {b}");
+            seen += usize::from(a > 0.0);
+        }
+        assert!(seen > 150, "only {seen} paths accelerate the axis");
     }
 
     #[test]
