@@ -386,7 +386,7 @@ fn segment_times_by(
     // Corner k joins move k-1 and move k, as a speed in the corner rule's space; corners 0
     // and n are the start and end (stopped). The passes below need only the motions.
     let mut w = vec![0.0; n + 1];
-    let mut m: Vec<Motion> = Vec::with_capacity(n);
+    let mut m = Chunked::with_capacity(n);
     let cap = |p: &Profile| {
         if p.motion.to_path > 0.0 {
             p.motion.top / p.motion.to_path
@@ -405,7 +405,7 @@ fn segment_times_by(
     }
     // Backward: every move must brake from its entry to its exit.
     for k in (0..n).rev() {
-        let mv = &m[k];
+        let mv = m.get(k);
         if mv.p <= NULL_MOVE {
             w[k] = w[k].min(w[k + 1]);
             continue;
@@ -416,7 +416,7 @@ fn segment_times_by(
     }
     // Forward: and speed up from its entry to its exit.
     for k in 0..n {
-        let mv = &m[k];
+        let mv = m.get(k);
         if mv.p <= NULL_MOVE {
             w[k + 1] = w[k + 1].min(w[k]);
             continue;
@@ -428,10 +428,44 @@ fn segment_times_by(
     // Each move's time over its entry speed, which no later move reads: the corner speeds'
     // vector becomes the times' (one place to spare).
     for k in 0..n {
-        w[k] = move_time(&m[k], w[k] * m[k].to_path, w[k + 1] * m[k].to_path);
+        let mv = m.get(k);
+        w[k] = move_time(mv, w[k] * mv.to_path, w[k + 1] * mv.to_path);
     }
     w.truncate(n);
     w
+}
+
+/// Motions kept in blocks of [`CHUNK`]: in wasm, where memory is never given back, one
+/// block for a long path's motions (7.9 MB on the head five-axis) found no room among
+/// what the plan had freed and grew the memory by that much.
+struct Chunked {
+    chunks: Vec<Vec<Motion>>,
+}
+
+/// Motions per block (160 KB).
+const CHUNK: usize = 4096;
+
+impl Chunked {
+    fn with_capacity(n: usize) -> Self {
+        Chunked {
+            chunks: Vec::with_capacity(n.div_ceil(CHUNK)),
+        }
+    }
+
+    fn push(&mut self, m: Motion) {
+        match self.chunks.last_mut() {
+            Some(c) if c.len() < CHUNK => c.push(m),
+            _ => {
+                let mut c = Vec::with_capacity(CHUNK);
+                c.push(m);
+                self.chunks.push(c);
+            }
+        }
+    }
+
+    fn get(&self, k: usize) -> &Motion {
+        &self.chunks[k / CHUNK][k % CHUNK]
+    }
 }
 
 /// How long a path takes on a machine.

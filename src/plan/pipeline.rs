@@ -124,7 +124,7 @@ pub fn finish(
             let at = |o: u32| (o != u32::MAX).then_some(o as usize);
             draft.footprints = origin
                 .iter()
-                .map(|&o| at(o).map_or(Footprint::NONE, |i| draft.footprints[i]))
+                .map(|&o| at(o).map_or(Footprint::NONE, |i| draft.footprints.get(i)))
                 .collect();
             left = origin
                 .iter()
@@ -227,7 +227,7 @@ pub fn finish(
         .filter_map(|i| {
             why[i]
                 .or(tight[i].then_some(Why::TooTight))
-                .map(|w| (draft.footprints[i], w))
+                .map(|w| (draft.footprints.get(i), w))
         })
         .collect();
     let points = rest_fps.len();

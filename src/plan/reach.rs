@@ -10,7 +10,7 @@
 //!
 //! Owns: the reasons, the split, the rest regions. Must not: choose axes or route air moves.
 
-use super::draft::{Draft, Footprint};
+use super::draft::{Draft, Footprint, Footprints};
 use super::toolpath::{Move, MoveKind, PatchRun, Toolpath};
 use crate::error::Result;
 use crate::geom::{Point3, Vector3};
@@ -368,7 +368,7 @@ const ROUNDING_WIDENING: f64 = 1e-9;
 fn touching_lifted(
     coarse_work_per_move: usize,
     path: &Toolpath,
-    footprints: &[Footprint],
+    footprints: &Footprints,
     lifted: &[usize],
     lifted_extent: &[f64],
     reach: f64,
@@ -384,7 +384,7 @@ fn touching_lifted(
         path.moves
             .iter()
             .enumerate()
-            .filter(|(i, m)| m.kind.on_surface() && !footprints[*i].is_none())
+            .filter(|(i, m)| m.kind.on_surface() && !footprints.get(*i).is_none())
     };
     type Grid = std::collections::HashMap<[i64; 3], Vec<usize>>;
     let key = |p: &[f64; 3], cell: f64| p.map(|x| (x / cell).floor() as i64);
@@ -478,7 +478,7 @@ fn touching_lifted(
 pub fn tight_near_lifts(
     model: &Model,
     path: &Toolpath,
-    footprints: &[Footprint],
+    footprints: &Footprints,
     left: &[f64],
     scallop_mm: f64,
     progress: &mut dyn FnMut(f64) -> bool,
@@ -494,7 +494,7 @@ pub fn tight_near_lifts(
     }
     // How far a footprint reaches from its contact point (mm).
     let extent = |i: usize| -> f64 {
-        let f = &footprints[i];
+        let f = footprints.get(i);
         if f.is_none() {
             return 0.0;
         }
@@ -556,7 +556,7 @@ pub fn tight_near_lifts(
         if k % PROGRESS_EVERY == 0 && !progress(share * k as f64) {
             return None;
         }
-        let f = footprints[i];
+        let f = footprints.get(i);
         // Every sample of the footprint tests only the balls near it.
         probe
             .probe
@@ -1014,7 +1014,7 @@ pub fn cut_end_halves(
     }
     let mut out = Vec::new();
     for (i, m) in moves.iter().enumerate() {
-        let fp = draft.footprints[i];
+        let fp = draft.footprints.get(i);
         if skip[i].is_some() || !m.kind.on_surface() || fp.is_none() {
             continue;
         }
@@ -1026,7 +1026,7 @@ pub fn cut_end_halves(
             if !n.kind.on_surface()
                 || n.patch != m.patch
                 || n.line != m.line
-                || draft.footprints[j].is_none()
+                || draft.footprints.get(j).is_none()
             {
                 continue;
             }
@@ -1223,7 +1223,7 @@ mod tests {
                     }
                 })
                 .collect();
-            let footprints: Vec<Footprint> = (0..n)
+            let footprints: Footprints = (0..n)
                 .map(|i| {
                     if i % 7 == 3 {
                         Footprint::NONE
@@ -1261,7 +1261,7 @@ mod tests {
             };
             let (coarse, fine) = (find(usize::MAX), find(0));
             let every_pair: Vec<(usize, f64)> = (0..n)
-                .filter(|&i| !footprints[i].is_none())
+                .filter(|&i| !footprints.get(i).is_none())
                 .filter(|&i| {
                     lifted.iter().zip(&lifted_extent).any(|(&k, &e)| {
                         let d = (path.moves[k].cc_point - path.moves[i].cc_point).norm();
@@ -1403,7 +1403,7 @@ mod tests {
                 runs,
                 params,
             },
-            footprints: vec![Footprint::NONE; n],
+            footprints: (0..n).map(|_| Footprint::NONE).collect(),
             safe_z: 10.0,
             forced_retractions: 0,
             isfc: None,
@@ -1472,7 +1472,7 @@ mod tests {
                 }],
                 params: vec![[0.0, 0.0]; n],
             },
-            footprints: vec![Footprint::NONE; n],
+            footprints: (0..n).map(|_| Footprint::NONE).collect(),
             safe_z: 10.0,
             forced_retractions: 0,
             isfc: None,
