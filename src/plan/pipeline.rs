@@ -179,18 +179,31 @@ pub fn finish(
         }
     };
     let mut rounds = 0;
-    // The draft's moves become the path's (what the end halves below need of them is kept
-    // apart); another round takes them back from the path.
+    // The draft's moves and params become the path's (what the end halves need of the
+    // draft's moves is kept apart, and the params of the points left out); another round
+    // takes them back from the path.
     let along = reach::Along::of(&draft.toolpath.moves);
     let mut moves = std::mem::take(&mut draft.toolpath.moves);
-    let (mut path, air) = loop {
-        let (mut path, origin) = reach::split_taking(moves, &draft, &why);
+    let mut params = std::mem::take(&mut draft.toolpath.params);
+    let mut left_out: Vec<(u32, [f64; 2])> = match params.len() == n {
+        true => (0..n)
+            .filter(|&i| why[i].is_some() && along[i].kind.on_surface())
+            .map(|i| (i as u32, params[i]))
+            .collect(),
+        false => Vec::new(),
+    };
+    let (mut path, air, end_halves) = loop {
+        let (mut path, origin) = reach::split_taking(moves, params, &draft, &why);
+        // The half footprints at the cuts' ends, while the path is as split.
+        let end_halves =
+            reach::cut_end_halves(&path, &origin, &draft.footprints, &along, &why, &left_out);
         axis::fill_air_axes(&mut path);
         match air::route(model, &mut path, opts, dist) {
-            Routed::Done(stats) => break (path, stats),
+            Routed::Done(stats) => break (path, stats, end_halves),
             Routed::LeaveOut(cuts) => {
                 // The path is as split: its kept moves are the draft's.
                 moves = reach::unsplit(&path, &origin, &along);
+                params = reach::unsplit_params(&path, &origin, n);
                 rounds += 1;
                 if rounds > MAX_ROUTE_ROUNDS {
                     let p = path.moves[cuts[0]].cl_point;
@@ -205,19 +218,19 @@ pub fn finish(
                 for k in cuts {
                     if let Some(&o) = origin.get(k).filter(|&&o| o != u32::MAX) {
                         why[o as usize] = Some(Why::NoWayOut);
+                        if let Some(&q) = path.params.get(k) {
+                            left_out.push((o, q));
+                        }
                     }
                 }
+                left_out.sort_by_key(|l| l.0);
             }
         }
     };
     if !progress(0.85) {
         return Err(Error::Cancelled);
     }
-    // The half footprints at the cuts' ends, the last use of the draft's params: they go
-    // before the bridging grows the path.
-    let end_halves = reach::cut_end_halves(&draft, &along, &why);
-    drop(along);
-    draft.toolpath.params = Vec::new();
+    drop((along, left_out));
     // 4. Turns of the axis between cut points, checked for the shank and holder.
     axis::bridge_turns(&mut path, &obs, opts, &mut axes);
     // 5. The rest area: points left out, and points kept whose lifted ball leaves more than

@@ -85,22 +85,29 @@ pub struct Rest {
 /// rebuilt the same way (straight up and down; [`super::air`] routes them afterwards).
 /// Returns the path and, per move, the draft move it cuts (`u32::MAX` for air moves).
 pub fn split(draft: &Draft, skip: &[Option<Why>]) -> (Toolpath, Vec<u32>) {
-    split_taking(draft.toolpath.moves.clone(), draft, skip)
+    let (moves, params) = (&draft.toolpath.moves, &draft.toolpath.params);
+    split_taking(moves.clone(), params.clone(), draft, skip)
 }
 
-/// [`split`] with the draft's moves given apart (`moves`; `draft.toolpath.moves` is not
-/// read): the path's moves are written over them, so the path's largest vector is not
-/// held twice (the draft's and the path's side by side were the head five-axis plan's peak,
-/// 34 of 66 MB).
+/// [`split`] with the draft's moves and params given apart (`moves`, `params`;
+/// `draft.toolpath.moves` and `params` are not read): the path's are written over them, so
+/// the path's largest vectors are not held twice (the draft's moves and the path's side by
+/// side were the head five-axis plan's peak, 34 of 66 MB; the params' grew its wasm memory
+/// by 3 MB).
 pub fn split_taking(
     mut moves: Vec<Move>,
+    mut params: Vec<[f64; 2]>,
     draft: &Draft,
     skip: &[Option<Why>],
 ) -> (Toolpath, Vec<u32>) {
     let old = &draft.toolpath;
     let n = moves.len();
-    let has_params = old.params.len() == n;
-    let param = |i: usize| old.params.get(i).copied().unwrap_or_default();
+    let has_params = params.len() == n;
+    if !has_params {
+        params = Vec::new();
+    }
+    // The param of kept move `k` once the kept moves are at the front.
+    let param = |params: &[[f64; 2]], k: usize| params.get(k).copied().unwrap_or_default();
     // The kept moves to the front, in order (each lands at or before where it was), with
     // the draft move each is and whether it starts a cut (its draft predecessor not kept).
     let keep = |m: &Move, i: usize| m.kind.on_surface() && skip[i].is_none();
@@ -114,6 +121,9 @@ pub fn split_taking(
     for i in 0..n {
         if keep(&moves[i], i) {
             moves[cut.len()] = moves[i];
+            if has_params {
+                params[cut.len()] = params[i];
+            }
             cut.push(i as u32);
         }
     }
@@ -123,12 +133,16 @@ pub fn split_taking(
     let cuts = (0..kept).filter(|&k| starts(k)).count();
     // Each cut comes down from above its first point and goes back up after its last.
     let len = kept + 2 * cuts;
-    let mut params = vec![[0.0; 2]; if has_params { len } else { 0 }];
     let mut origin = vec![u32::MAX; len];
     moves.truncate(kept);
     moves.reserve_exact(len - kept);
     if let Some(&filler) = moves.first() {
         moves.resize(len, filler);
+    }
+    if has_params {
+        params.truncate(kept);
+        params.reserve_exact(len - kept);
+        params.resize(len, [0.0; 2]);
     }
     // From the end back, each kept move to its place, the air moves round each cut beside
     // it: the places written lie above every kept move not yet moved.
@@ -138,7 +152,7 @@ pub fn split_taking(
         ..*m
     };
     let mut w = len;
-    let mut put = |moves: &mut [Move], m: Move, q: [f64; 2], o: u32| {
+    let mut put = |moves: &mut [Move], params: &mut [[f64; 2]], m: Move, q: [f64; 2], o: u32| {
         w -= 1;
         moves[w] = m;
         if has_params {
@@ -148,26 +162,44 @@ pub fn split_taking(
     };
     if kept > 0 {
         let last = moves[kept - 1];
-        let q = param(cut[kept - 1] as usize);
-        put(&mut moves, safe(&last, MoveKind::Retract), q, u32::MAX);
+        let q = param(&params, kept - 1);
+        put(
+            &mut moves,
+            &mut params,
+            safe(&last, MoveKind::Retract),
+            q,
+            u32::MAX,
+        );
     }
     for k in (0..kept).rev() {
         let m = moves[k];
-        let (i, q) = (cut[k], param(cut[k] as usize));
+        let (i, q) = (cut[k], param(&params, k));
         if !starts(k) {
-            put(&mut moves, m, q, i);
+            put(&mut moves, &mut params, m, q, i);
             continue;
         }
         let plunge = Move {
             kind: MoveKind::Plunge,
             ..m
         };
-        put(&mut moves, plunge, q, i);
-        put(&mut moves, safe(&m, MoveKind::Rapid), q, u32::MAX);
+        put(&mut moves, &mut params, plunge, q, i);
+        put(
+            &mut moves,
+            &mut params,
+            safe(&m, MoveKind::Rapid),
+            q,
+            u32::MAX,
+        );
         if k > 0 {
             let last = moves[k - 1];
-            let q = param(cut[k - 1] as usize);
-            put(&mut moves, safe(&last, MoveKind::Retract), q, u32::MAX);
+            let q = param(&params, k - 1);
+            put(
+                &mut moves,
+                &mut params,
+                safe(&last, MoveKind::Retract),
+                q,
+                u32::MAX,
+            );
         }
     }
     debug_assert_eq!(w, 0);
@@ -231,6 +263,21 @@ pub fn unsplit(path: &Toolpath, origin: &[u32], along: &[Along]) -> Vec<Move> {
         }
     }
     moves
+}
+
+/// The draft's params again, as [`unsplit`] gives its moves: each kept move's from the path
+/// (the others are zero: a split reads the params of the moves it keeps only).
+pub fn unsplit_params(path: &Toolpath, origin: &[u32], n: usize) -> Vec<[f64; 2]> {
+    if path.params.len() != path.moves.len() {
+        return Vec::new();
+    }
+    let mut params = vec![[0.0; 2]; n];
+    for (q, &o) in path.params.iter().zip(origin) {
+        if let Some(d) = params.get_mut(o as usize) {
+            *d = *q;
+        }
+    }
+    params
 }
 
 /// The runs of the draft over the split path: each keeps the moves it had that were kept;
@@ -1001,36 +1048,50 @@ impl Sets {
 /// footprint towards the left-out point (which the feed on to that point would have cut) is
 /// rest area too, with that point's reason: over it the ball's sphere alone leaves material
 /// growing with the distance from the point (head, three-axis, r 0.5 mm: 0.17 mm at the far
-/// corner of such a half, for a 0.05 mm scallop). `moves` ([`Along::of` the draft's moves) and
-/// `skip` have one entry per draft move.
+/// corner of such a half, for a 0.05 mm scallop).
+///
+/// Of the `path` as [`split_taking`] left it with `origin`: `footprints`, `along` ([`Along::of`]
+/// the draft's moves) and `skip` have one entry per draft move, `left_out` the params of the
+/// on-surface draft moves `skip` leaves out, by draft index (ascending).
 pub fn cut_end_halves(
-    draft: &Draft,
-    moves: &[Along],
+    path: &Toolpath,
+    origin: &[u32],
+    footprints: &Footprints,
+    along: &[Along],
     skip: &[Option<Why>],
+    left_out: &[(u32, [f64; 2])],
 ) -> Vec<(Footprint, Why)> {
-    let params = &draft.toolpath.params;
-    if params.len() != moves.len() || skip.len() != moves.len() {
+    if path.params.len() != path.moves.len() || skip.len() != along.len() {
         return Vec::new();
     }
     let mut out = Vec::new();
-    for (i, m) in moves.iter().enumerate() {
-        let fp = draft.footprints.get(i);
+    // The kept moves, in draft order.
+    for (&o, &p) in origin.iter().zip(&path.params) {
+        let i = o as usize;
+        let Some(m) = along.get(i) else {
+            continue;
+        };
+        let fp = footprints.get(i);
         if skip[i].is_some() || !m.kind.on_surface() || fp.is_none() {
             continue;
         }
         for j in [i.wrapping_sub(1), i + 1] {
-            let (Some(n), Some(Some(why))) = (moves.get(j), skip.get(j)) else {
+            let (Some(n), Some(Some(why))) = (along.get(j), skip.get(j)) else {
                 continue;
             };
             // Only the neighbour along the same pass (links between passes stand for no area).
             if !n.kind.on_surface()
                 || n.patch != m.patch
                 || n.line != m.line
-                || draft.footprints.get(j).is_none()
+                || footprints.get(j).is_none()
             {
                 continue;
             }
-            let (p, q) = (params[i], params[j]);
+            let Ok(at) = left_out.binary_search_by_key(&(j as u32), |l| l.0) else {
+                debug_assert!(false, "left-out move {j} without its params");
+                continue;
+            };
+            let q = left_out[at].1;
             let [u0, u1, v0, v1] = fp.rect;
             let rect = if (q[0] - p[0]).abs() >= (q[1] - p[1]).abs() {
                 let pu = p[0].clamp(u0, u1);
@@ -1412,6 +1473,119 @@ mod tests {
         (draft, skip)
     }
 
+    /// The half footprints at the cuts' ends as first written, from the draft's own params
+    /// (the second method for [`cut_end_halves`], which reads the split path).
+    fn cut_end_halves_of_draft(draft: &Draft, skip: &[Option<Why>]) -> Vec<(Footprint, Why)> {
+        let (moves, params) = (&draft.toolpath.moves, &draft.toolpath.params);
+        let mut out = Vec::new();
+        if params.len() != moves.len() {
+            return out;
+        }
+        for (i, m) in moves.iter().enumerate() {
+            let fp = draft.footprints.get(i);
+            if skip[i].is_some() || !m.kind.on_surface() || fp.is_none() {
+                continue;
+            }
+            for j in [i.wrapping_sub(1), i + 1] {
+                let (Some(n), Some(Some(why))) = (moves.get(j), skip.get(j)) else {
+                    continue;
+                };
+                if !n.kind.on_surface()
+                    || n.patch != m.patch
+                    || n.line != m.line
+                    || draft.footprints.get(j).is_none()
+                {
+                    continue;
+                }
+                let (p, q) = (params[i], params[j]);
+                let [u0, u1, v0, v1] = fp.rect;
+                let rect = if (q[0] - p[0]).abs() >= (q[1] - p[1]).abs() {
+                    match q[0] < p[0] {
+                        true => [u0, p[0].clamp(u0, u1), v0, v1],
+                        false => [p[0].clamp(u0, u1), u1, v0, v1],
+                    }
+                } else {
+                    match q[1] < p[1] {
+                        true => [u0, u1, v0, p[1].clamp(v0, v1)],
+                        false => [u0, u1, p[1].clamp(v0, v1), v1],
+                    }
+                };
+                let half = Footprint {
+                    patch: fp.patch,
+                    rect,
+                };
+                if !half.is_none() {
+                    out.push((half, *why));
+                }
+            }
+        }
+        out
+    }
+
+    /// The params of the on-surface moves `skip` leaves out, by draft index.
+    fn left_out_params(draft: &Draft, skip: &[Option<Why>]) -> Vec<(u32, [f64; 2])> {
+        let (moves, params) = (&draft.toolpath.moves, &draft.toolpath.params);
+        (0..params.len())
+            .filter(|&i| skip[i].is_some() && moves[i].kind.on_surface())
+            .map(|i| (i as u32, params[i]))
+            .collect()
+    }
+
+    #[test]
+    fn cut_end_halves_from_the_split_path_equal_those_from_the_draft() {
+        // Random drafts with footprints round their params (some none), split; then split
+        // again from the path with more points left out, their params taken from the path.
+        let mut next = crate::testing::uniform(0xe4d_4a1f);
+        let mut halves = 0;
+        for case in 0..400 {
+            let n = (next() * 60.0) as usize;
+            let (mut draft, skip) = random_draft(&mut next, n);
+            let params = draft.toolpath.params.clone();
+            draft.footprints = (0..n)
+                .map(|i| match params.get(i) {
+                    Some(&[u, v]) if next() < 0.9 => Footprint {
+                        patch: draft.toolpath.moves[i].patch,
+                        rect: [u - next(), u + next(), v - next(), v + next()],
+                    },
+                    _ => Footprint::NONE,
+                })
+                .collect();
+            let along = Along::of(&draft.toolpath.moves);
+            let (path, origin) = split(&draft, &skip);
+            let want = cut_end_halves_of_draft(&draft, &skip);
+            let left_out = left_out_params(&draft, &skip);
+            let got = cut_end_halves(&path, &origin, &draft.footprints, &along, &skip, &left_out);
+            assert_eq!(got, want, "case {case}");
+            halves += want.len();
+            let mut more = skip.clone();
+            let mut left_out = left_out;
+            for (k, &o) in origin.iter().enumerate().filter(|(_, &o)| o != u32::MAX) {
+                if next() < 0.3 {
+                    more[o as usize] = Some(Why::NoWayOut);
+                    if let Some(&q) = path.params.get(k) {
+                        left_out.push((o, q));
+                    }
+                }
+            }
+            left_out.sort_by_key(|l| l.0);
+            let moves = unsplit(&path, &origin, &along);
+            let params = unsplit_params(&path, &origin, n);
+            let (path2, origin2) = split_taking(moves, params, &draft, &more);
+            let want2 = cut_end_halves_of_draft(&draft, &more);
+            let got2 = cut_end_halves(
+                &path2,
+                &origin2,
+                &draft.footprints,
+                &along,
+                &more,
+                &left_out,
+            );
+            assert_eq!(got2, want2, "case {case} again");
+            halves += want2.len();
+        }
+        assert!(halves > 500, "only {halves} halves");
+    }
+
     /// Split in place equals split in path order on 400 random drafts (up to 60 moves, up to
     /// half of them left out, with and without params), and split again from the path
     /// ([`unsplit`]) with more points left out equals splitting the draft with all of them.
@@ -1435,7 +1609,8 @@ mod tests {
                 }
             }
             let again = unsplit(&got, &origin, &Along::of(&draft.toolpath.moves));
-            let (got2, origin2) = split_taking(again, &draft, &more);
+            let params = unsplit_params(&got, &origin, n);
+            let (got2, origin2) = split_taking(again, params, &draft, &more);
             let (want2, want_origin2) = split_in_order(&draft, &more);
             assert_eq!(got2.moves, want2.moves, "case {case}: moves again");
             assert_eq!(got2.params, want2.params, "case {case}: params again");
