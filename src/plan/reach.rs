@@ -1091,33 +1091,38 @@ pub fn cut_end_halves(
                 debug_assert!(false, "left-out move {j} without its params");
                 continue;
             };
-            let q = left_out[at].1;
-            let [u0, u1, v0, v1] = fp.rect;
-            let rect = if (q[0] - p[0]).abs() >= (q[1] - p[1]).abs() {
-                let pu = p[0].clamp(u0, u1);
-                if q[0] < p[0] {
-                    [u0, pu, v0, v1]
-                } else {
-                    [pu, u1, v0, v1]
-                }
-            } else {
-                let pv = p[1].clamp(v0, v1);
-                if q[1] < p[1] {
-                    [u0, u1, v0, pv]
-                } else {
-                    [u0, u1, pv, v1]
-                }
-            };
-            let half = Footprint {
-                patch: fp.patch,
-                rect,
-            };
+            let half = half_towards(&fp, p, left_out[at].1);
             if !half.is_none() {
                 out.push((half, *why));
             }
         }
     }
     out
+}
+
+/// The half of footprint `fp` of a point at params `p` towards a neighbour at `q` along its
+/// pass: cut at `p` across the parameter in which the neighbour lies farther.
+fn half_towards(fp: &Footprint, p: [f64; 2], q: [f64; 2]) -> Footprint {
+    let [u0, u1, v0, v1] = fp.rect;
+    let rect = if (q[0] - p[0]).abs() >= (q[1] - p[1]).abs() {
+        let pu = p[0].clamp(u0, u1);
+        if q[0] < p[0] {
+            [u0, pu, v0, v1]
+        } else {
+            [pu, u1, v0, v1]
+        }
+    } else {
+        let pv = p[1].clamp(v0, v1);
+        if q[1] < p[1] {
+            [u0, u1, v0, pv]
+        } else {
+            [u0, u1, pv, v1]
+        }
+    };
+    Footprint {
+        patch: fp.patch,
+        rect,
+    }
 }
 
 /// The rest area of `footprints` — the first `points` of them cut points left out or kept
@@ -1473,49 +1478,28 @@ mod tests {
         (draft, skip)
     }
 
-    /// The half footprints at the cuts' ends as first written, from the draft's own params
-    /// (the second method for [`cut_end_halves`], which reads the split path).
+    /// The half footprints at the cuts' ends as first written: over the draft's moves, each
+    /// kept one's neighbours looked up by index with the draft's own params (the second
+    /// method for [`cut_end_halves`], which walks the split path).
     fn cut_end_halves_of_draft(draft: &Draft, skip: &[Option<Why>]) -> Vec<(Footprint, Why)> {
         let (moves, params) = (&draft.toolpath.moves, &draft.toolpath.params);
+        let fps = &draft.footprints;
+        let along_pass = |i: usize, j: usize| {
+            let (a, b) = (&moves[i], &moves[j]);
+            b.kind.on_surface() && (a.patch, a.line) == (b.patch, b.line) && !fps.get(j).is_none()
+        };
+        let kept = |i: usize| skip[i].is_none() && moves[i].kind.on_surface();
         let mut out = Vec::new();
-        if params.len() != moves.len() {
-            return out;
-        }
-        for (i, m) in moves.iter().enumerate() {
-            let fp = draft.footprints.get(i);
-            if skip[i].is_some() || !m.kind.on_surface() || fp.is_none() {
-                continue;
-            }
-            for j in [i.wrapping_sub(1), i + 1] {
-                let (Some(n), Some(Some(why))) = (moves.get(j), skip.get(j)) else {
-                    continue;
-                };
-                if !n.kind.on_surface()
-                    || n.patch != m.patch
-                    || n.line != m.line
-                    || draft.footprints.get(j).is_none()
-                {
-                    continue;
-                }
-                let (p, q) = (params[i], params[j]);
-                let [u0, u1, v0, v1] = fp.rect;
-                let rect = if (q[0] - p[0]).abs() >= (q[1] - p[1]).abs() {
-                    match q[0] < p[0] {
-                        true => [u0, p[0].clamp(u0, u1), v0, v1],
-                        false => [p[0].clamp(u0, u1), u1, v0, v1],
+        for i in (0..moves.len()).filter(|&i| params.len() == moves.len() && kept(i)) {
+            for j in [i.wrapping_sub(1), i + 1]
+                .into_iter()
+                .filter(|&j| j < moves.len())
+            {
+                if let (Some(why), false) = (skip[j], fps.get(i).is_none()) {
+                    let half = half_towards(&fps.get(i), params[i], params[j]);
+                    if along_pass(i, j) && !half.is_none() {
+                        out.push((half, why));
                     }
-                } else {
-                    match q[1] < p[1] {
-                        true => [u0, u1, v0, p[1].clamp(v0, v1)],
-                        false => [u0, u1, p[1].clamp(v0, v1), v1],
-                    }
-                };
-                let half = Footprint {
-                    patch: fp.patch,
-                    rect,
-                };
-                if !half.is_none() {
-                    out.push((half, *why));
                 }
             }
         }
