@@ -116,8 +116,9 @@ struct State {
 }
 
 /// States at most one move may have: a state's way back ([`solve_rotaries_by`]) is kept in
-/// two bytes. A layer holds one state per orientation branch and turn the limits allow,
-/// a few on any machine (limits of ±23 000° on both rotaries would be needed to exceed it).
+/// two bytes. A layer holds one state per orientation branch and turn the limits allow, a
+/// few on any machine: two branches of 181 turns of each rotary, limits of ±32 600° on both,
+/// would exceed it.
 const MAX_LAYER_STATES: usize = u16::MAX as usize;
 
 /// True when `a` and `b` are the same state (endless axes up to whole turns).

@@ -128,10 +128,12 @@ impl Footprints {
         }
     }
 
+    /// How many (one per move of the draft).
     pub fn len(&self) -> usize {
         self.0.len()
     }
 
+    /// True for a draft without moves.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }

@@ -108,8 +108,8 @@ pub fn split_taking(
     }
     // The param of kept move `k` once the kept moves are at the front.
     let param = |params: &[[f64; 2]], k: usize| params.get(k).copied().unwrap_or_default();
-    // The kept moves to the front, in order (each lands at or before where it was), with
-    // the draft move each is and whether it starts a cut (its draft predecessor not kept).
+    // The kept moves (and their params) to the front, in order (each lands at or before
+    // where it was), with the draft move each is.
     let keep = |m: &Move, i: usize| m.kind.on_surface() && skip[i].is_none();
     let mut cut: Vec<u32> = Vec::with_capacity(
         moves
@@ -161,15 +161,11 @@ pub fn split_taking(
         origin[w] = o;
     };
     if kept > 0 {
-        let last = moves[kept - 1];
-        let q = param(&params, kept - 1);
-        put(
-            &mut moves,
-            &mut params,
-            safe(&last, MoveKind::Retract),
-            q,
-            u32::MAX,
+        let (up, q) = (
+            safe(&moves[kept - 1], MoveKind::Retract),
+            param(&params, kept - 1),
         );
+        put(&mut moves, &mut params, up, q, u32::MAX);
     }
     for k in (0..kept).rev() {
         let m = moves[k];
@@ -182,24 +178,15 @@ pub fn split_taking(
             kind: MoveKind::Plunge,
             ..m
         };
+        let above = safe(&m, MoveKind::Rapid);
         put(&mut moves, &mut params, plunge, q, i);
-        put(
-            &mut moves,
-            &mut params,
-            safe(&m, MoveKind::Rapid),
-            q,
-            u32::MAX,
-        );
+        put(&mut moves, &mut params, above, q, u32::MAX);
         if k > 0 {
-            let last = moves[k - 1];
-            let q = param(&params, k - 1);
-            put(
-                &mut moves,
-                &mut params,
-                safe(&last, MoveKind::Retract),
-                q,
-                u32::MAX,
+            let (up, q) = (
+                safe(&moves[k - 1], MoveKind::Retract),
+                param(&params, k - 1),
             );
+            put(&mut moves, &mut params, up, q, u32::MAX);
         }
     }
     debug_assert_eq!(w, 0);
