@@ -185,10 +185,13 @@ pub fn finish(
     let along = reach::Along::of(&draft.toolpath.moves);
     let mut moves = std::mem::take(&mut draft.toolpath.moves);
     let mut params = std::mem::take(&mut draft.toolpath.params);
-    let mut left_out: Vec<(u32, [f64; 2])> = (0..params.len().min(n))
-        .filter(|&i| params.len() == n && why[i].is_some() && along[i].kind.on_surface())
-        .map(|i| (i as u32, params[i]))
-        .collect();
+    let mut left_out: Vec<(u32, [f64; 2])> = Vec::new();
+    if params.len() == n {
+        left_out = (0..n)
+            .filter(|&i| why[i].is_some() && along[i].kind.on_surface())
+            .map(|i| (i as u32, params[i]))
+            .collect();
+    }
     let (mut path, air, end_halves) = loop {
         let (mut path, origin) = reach::split_taking(moves, params, &draft, &why);
         // The half footprints at the cuts' ends, while the path is as split.

@@ -118,11 +118,10 @@ pub const ACCELERATION_SAMPLE_S: f64 = 0.05;
 struct RunSamples {
     /// Time (s) and axis of the run's last point; `None` between runs.
     last: Option<(f64, Vector3)>,
-    /// Index of the next sample.
+    /// Index of the next sample: the samples the run has had.
     next: usize,
-    /// The last samples, newest last (`count` of them, at most three).
+    /// The last samples, newest last (the run's first `next` of them, up to three).
     window: [Vector3; 3],
-    count: usize,
     /// Largest angular acceleration found (deg/s²).
     largest: f64,
 }
@@ -154,15 +153,13 @@ impl RunSamples {
             }
         }
         self.next = 0;
-        self.count = 0;
     }
 
     fn sample(&mut self, axis: Vector3) {
         self.next += 1;
         self.window.rotate_left(1);
         self.window[2] = axis;
-        self.count = (self.count + 1).min(3);
-        if self.count < 3 {
+        if self.next < 3 {
             return;
         }
         let dt = ACCELERATION_SAMPLE_S;
