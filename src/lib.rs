@@ -23,6 +23,7 @@ pub mod layout;
 pub mod machine;
 pub mod model;
 pub mod plan;
+mod sort;
 pub mod surface;
 #[cfg(test)]
 mod testing;

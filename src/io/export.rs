@@ -55,7 +55,7 @@ pub fn obj(t: &Tessellation, name: &str) -> String {
         let _ = writeln!(s, "vn {} {} {}", n[0], n[1], n[2]);
     }
     let mut order: Vec<usize> = (0..t.patch_ids.len()).collect();
-    order.sort_by_key(|&i| (t.patch_ids[i], i));
+    crate::sort::sort_by_key(&mut order, |&i| (t.patch_ids[i], i));
     let mut current = None;
     for i in order {
         if current != Some(t.patch_ids[i]) {

@@ -375,7 +375,7 @@ pub fn write(mesh: &TMesh, name: &str) -> String {
             (a.min(b), a.max(b), h.knot)
         })
         .collect();
-    knots.sort_by_key(|x| (x.0, x.1));
+    crate::sort::sort_by_key(&mut knots, |x| (x.0, x.1));
     knots.dedup_by(|x, y| x.0 == y.0 && x.1 == y.1);
     let knots: Vec<String> = knots
         .into_iter()

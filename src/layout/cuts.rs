@@ -26,7 +26,7 @@ pub fn cut_at_concave_corners(
         lines[1].extend([r[2], r[3]]);
     }
     for l in lines.iter_mut() {
-        l.sort_by(f64::total_cmp);
+        crate::sort::sort_floats(l);
         l.dedup_by(|a, b| (*a - *b).abs() <= tol);
     }
     let [s, t] = &lines;

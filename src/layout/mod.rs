@@ -298,7 +298,7 @@ impl PatchLayout {
             let positions = |mut c: Vec<f64>, len: f64| {
                 let tol = KNOT_MATCH_REL * len;
                 c.retain(|&x| x > tol && x < len - tol);
-                c.sort_by(f64::total_cmp);
+                crate::sort::sort_floats(&mut c);
                 c.dedup_by(|a, b| (*a - *b).abs() <= tol);
                 let mut out = vec![0.0];
                 out.extend(c);
@@ -529,7 +529,7 @@ impl PatchLayout {
                 }
             }
         }
-        connections.sort_by_key(|c| (c.a, c.b));
+        crate::sort::sort_by_key(&mut connections, |c| (c.a, c.b));
         PatchLayout {
             patches,
             connections,
@@ -978,7 +978,7 @@ impl Patch {
             t_breaks.extend([a[1], b[1]]);
         }
         for v in [&mut s_breaks, &mut t_breaks] {
-            v.sort_by(f64::total_cmp);
+            crate::sort::sort_floats(v);
             v.dedup_by(|a, b| (*a - *b).abs() <= tol);
         }
         let mut cell_piece = Vec::with_capacity((s_breaks.len() - 1) * (t_breaks.len() - 1));

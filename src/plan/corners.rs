@@ -189,7 +189,7 @@ fn candidates(
     }
     // Corners that suit the preferred crossfeed first (diagonal ones suit both), then those
     // its natural pass count reaches.
-    out.sort_by_key(|&(f, _)| {
+    crate::sort::sort_by_key(&mut out, |&(f, _)| {
         (
             !crossfeeds(s, f).contains(&preferred[p]),
             pref.against_parity(p, s, f),

@@ -283,7 +283,7 @@ const MIN_PARAM_STEP: f64 = 1e-9;
 /// each gap and half-way (each pass's samples serve both gaps it borders).
 pub(crate) fn predicted(s: &dyn ParamSurface, dir: FeedDir, ws: &[f64], r: f64) -> f64 {
     let mut sorted = ws.to_vec();
-    sorted.sort_by(f64::total_cmp);
+    crate::sort::sort_floats(&mut sorted);
     let row = |w: f64| -> Vec<Option<DiffGeom>> {
         let mut line = s.line(dir, w.min(1.0));
         pass_samples()

@@ -223,7 +223,7 @@ pub fn finish(
                         }
                     }
                 }
-                left_out.sort_by_key(|l| l.0);
+                crate::sort::sort_by_key(&mut left_out, |l| l.0);
             }
         }
     };

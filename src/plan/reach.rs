@@ -623,7 +623,7 @@ pub fn tight_near_lifts(
                 }
             }
         }
-        starts.sort_by(|a, b| b.0.total_cmp(&a.0));
+        crate::sort::sort_by(&mut starts, |a, b| b.0.total_cmp(&a.0));
         let mut top = grid.iter().map(|g| g.0).fold(f64::NEG_INFINITY, f64::max);
         let focus_at = |probe: &mut FootprintProbe, (u, v): (f64, f64), (hu, hv): (f64, f64)| {
             let patch = &model.layout.patches[f.patch as usize];
@@ -1135,7 +1135,7 @@ pub fn rest(
     // Footprints of one patch and reason touching each other join: bucketed by patch and
     // reason, then swept in u.
     let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| {
+    crate::sort::sort_by(&mut order, |&a, &b| {
         (fps[a].0.patch, fps[a].1)
             .cmp(&(fps[b].0.patch, fps[b].1))
             .then(fps[a].0.rect[0].total_cmp(&fps[b].0.rect[0]))
@@ -1231,7 +1231,7 @@ pub fn rest(
             }
         })
         .collect();
-    regions.sort_by(|a, b| {
+    crate::sort::sort_by(&mut regions, |a, b| {
         b.area_mm2
             .total_cmp(&a.area_mm2)
             .then(a.patch.cmp(&b.patch))

@@ -265,7 +265,7 @@ fn grid_form(mesh: &TMesh, f: usize, fb: &[crate::tmesh::walk::FaceBlend]) -> Re
 fn breaks(knots: impl Iterator<Item = f64>, len: f64) -> Vec<f64> {
     let tol = KNOT_MATCH_REL * len;
     let mut inner: Vec<f64> = knots.filter(|&k| k > tol && k < len - tol).collect();
-    inner.sort_by(f64::total_cmp);
+    crate::sort::sort_floats(&mut inner);
     let mut out = vec![0.0];
     let mut last = 0.0;
     for k in inner {

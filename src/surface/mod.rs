@@ -521,7 +521,7 @@ fn extreme_box(faces: &[FaceSurface]) -> Aabb {
     }
     for d in 0..6 {
         let mut cands: Vec<(f64, usize, f64, f64)> = best.iter().map(|b| b[d]).collect();
-        cands.sort_by(|a, b| b.0.total_cmp(&a.0));
+        crate::sort::sort_by(&mut cands, |a, b| b.0.total_cmp(&a.0));
         for &(_, fi, mut u, mut v) in cands.iter().take(BOX_CANDIDATES) {
             let f = &faces[fi];
             let mut half = 1.0 / (n - 1) as f64;

@@ -390,7 +390,7 @@ pub fn tessellate(
             vs.extend([r[2] / face.height, r[3] / face.height]);
         }
         for g in [&mut us, &mut vs] {
-            g.sort_by(f64::total_cmp);
+            crate::sort::sort_floats(g);
             g.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
         }
         let (gu, gv) = (us.len() - 1, vs.len() - 1);

@@ -356,7 +356,7 @@ fn split_function(a: &LocalKnots, c: f64, tol: f64) -> Vec<(LocalKnots, f64)> {
         return vec![(*a, 1.0)];
     }
     let mut six = [a[0], a[1], a[2], a[3], a[4], c];
-    six.sort_by(f64::total_cmp);
+    crate::sort::sort_floats(&mut six);
     let first = [six[0], six[1], six[2], six[3], six[4]];
     let last = [six[1], six[2], six[3], six[4], six[5]];
     let alpha = if a[3] > a[0] {

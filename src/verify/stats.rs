@@ -35,7 +35,7 @@ pub fn weighted_quantile(chunks: &[Vec<(f64, f64)>], q: f64) -> Option<f64> {
         below += w;
     }
     let mut inside: Vec<(f64, f64)> = values().copied().filter(|&(v, _)| bin(v) == pick).collect();
-    inside.sort_by(|a, b| a.0.total_cmp(&b.0));
+    crate::sort::sort_by(&mut inside, |a, b| a.0.total_cmp(&b.0));
     for &(v, w) in &inside {
         below += w;
         if below >= target {

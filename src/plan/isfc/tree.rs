@@ -44,7 +44,7 @@ impl Sets {
 /// `cells` cells: indices into `links`, in the order chosen.
 pub fn kruskal(cells: usize, links: &[Link]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..links.len()).collect();
-    order.sort_by(|&x, &y| {
+    crate::sort::sort_by(&mut order, |&x, &y| {
         let (p, q) = (&links[x], &links[y]);
         p.cost
             .total_cmp(&q.cost)

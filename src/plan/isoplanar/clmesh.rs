@@ -353,7 +353,7 @@ impl Strip {
             .iter()
             .map(|&(s, uv_b)| (side_param(self.side_b, uv_b), side_uv(self.side, s)))
             .collect();
-        cols.sort_by(|x, y| x.0.total_cmp(&y.0));
+        crate::sort::sort_by(&mut cols, |x, y| x.0.total_cmp(&y.0));
         Strip {
             convex: self.convex,
             a: self.b,

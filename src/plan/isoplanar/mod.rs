@@ -440,7 +440,7 @@ pub fn slices(
     let cut = |c: f64, tris: &[u32]| cut_plane(&mesh, &frame, &x_prime, c, tris, seam);
     // What is still too wide: passes added half-way between neighbours over that stretch.
     // Each pass's check points are found once, when the pass is made.
-    passes.sort_by(|a, b| a.plane.total_cmp(&b.plane));
+    crate::sort::sort_by(&mut passes, |a, b| a.plane.total_cmp(&b.plane));
     let mut checks: Vec<PassChecks> = passes
         .iter()
         .map(|p| PassChecks::new(model, &mesh, opts, &frame, p))
@@ -485,7 +485,7 @@ pub fn slices(
         }
         // Sorted by plane, the checks kept beside their passes (a stable sort, as before).
         let mut both: Vec<(Pass, PassChecks)> = passes.into_iter().zip(checks).collect();
-        both.sort_by(|a, b| a.0.plane.total_cmp(&b.0.plane));
+        crate::sort::sort_by(&mut both, |a, b| a.0.plane.total_cmp(&b.0.plane));
         (passes, checks) = both.into_iter().unzip();
     }
     let planes = {

@@ -193,7 +193,7 @@ fn components(grid: &Grid<bool>) -> Vec<Vec<(usize, usize)>> {
                     }
                 }
             }
-            comp.sort_by_key(|&(x, y)| (y, x));
+            crate::sort::sort_by_key(&mut comp, |&(x, y)| (y, x));
             out.push(comp);
         }
     }

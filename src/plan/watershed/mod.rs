@@ -114,7 +114,7 @@ pub fn features(model: &Model, per_unit: f64) -> Result<Features> {
         .copied()
         .filter(|c| c.is_finite())
         .collect();
-    values.sort_by(f64::total_cmp);
+    crate::sort::sort_floats(&mut values);
     let reference = values
         .get(((values.len() as f64 - 1.0) * REFERENCE_QUANTILE).round() as usize)
         .copied()

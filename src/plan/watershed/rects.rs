@@ -32,7 +32,7 @@ pub fn rectangles(faces: &[[f64; 4]], boxes: &[(u32, [f64; 4])], tol: f64) -> Ve
         for x in lines[k].iter_mut() {
             *x = x.clamp(lo[k], hi[k]);
         }
-        lines[k].sort_by(f64::total_cmp);
+        crate::sort::sort_floats(&mut lines[k]);
         lines[k].dedup_by(|a, b| (*a - *b).abs() <= tol);
     }
     let (ns, nt) = (

@@ -59,7 +59,7 @@ pub fn watershed(
             }
         }
     }
-    markers.sort_by(|a, b| {
+    crate::sort::sort_by(&mut markers, |a, b| {
         values
             .at(b.0, b.1)
             .total_cmp(&values.at(a.0, a.1))
