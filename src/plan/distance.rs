@@ -25,7 +25,9 @@ struct Node {
 
 /// The surface's triangles in a hierarchy of boxes.
 pub struct SurfaceDistance {
-    tris: Vec<[Point3; 3]>,
+    /// The triangles in the leaves' order, in single precision: the tessellation's
+    /// positions are single precision, so this holds them exactly in half the memory.
+    tris: Vec<Tri>,
     nodes: Vec<Node>,
     /// Largest distance between the triangles and the surface (mm).
     pub tolerance_mm: f64,
@@ -130,73 +132,77 @@ impl SurfaceDistance {
                 measured = measured.max(point_triangle_distance(&q, &tris[k]));
             }
         }
-        let mut d = SurfaceDistance {
+        let (nodes, tris) = Self::build(&tris);
+        SurfaceDistance {
             tris,
-            nodes: Vec::new(),
+            nodes,
             tolerance_mm: (MEASURE_MARGIN * measured).max(chordal_mm) + reach * f32::EPSILON as f64,
-        };
-        d.build();
-        d
+        }
     }
 
-    fn build(&mut self) {
-        let n = self.tris.len();
+    /// The hierarchy over `tris`, and the triangles in its leaves' order.
+    fn build(tris: &[[Point3; 3]]) -> (Vec<Node>, Vec<Tri>) {
+        let n = tris.len();
         if n == 0 {
-            return;
+            return (Vec::new(), Vec::new());
         }
         let mut order: Vec<u32> = (0..n as u32).collect();
         let centre = |t: &[Point3; 3]| (t[0].coords + t[1].coords + t[2].coords) / 3.0;
-        let centres: Vec<Vector3> = self.tris.iter().map(centre).collect();
+        let centres: Vec<Vector3> = tris.iter().map(centre).collect();
         // Nodes built breadth-first so children sit next to each other.
-        self.nodes.push(Node {
+        let mut nodes = vec![Node {
             lo: [0.0; 3],
             hi: [0.0; 3],
             first: 0,
             count: n as u32,
-        });
+        }];
         let mut stack = vec![(0usize, 0usize, n, 0usize)];
         while let Some((node, a, b, depth)) = stack.pop() {
             let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
             for &t in &order[a..b] {
-                for q in &self.tris[t as usize] {
+                for q in &tris[t as usize] {
                     for k in 0..3 {
                         lo[k] = least(lo[k], q[k]);
                         hi[k] = most(hi[k], q[k]);
                     }
                 }
             }
-            self.nodes[node].lo = lo;
-            self.nodes[node].hi = hi;
+            nodes[node].lo = lo;
+            nodes[node].hi = hi;
             if b - a <= LEAF {
-                self.nodes[node].first = a as u32;
-                self.nodes[node].count = (b - a) as u32;
+                nodes[node].first = a as u32;
+                nodes[node].count = (b - a) as u32;
                 continue;
             }
             // Beyond [`AREA_DEPTH`] halves at the median, so the depth stays bounded.
             let mid = if depth < AREA_DEPTH {
-                a + split_by_area(&mut order[a..b], &centres, &self.tris)
+                a + split_by_area(&mut order[a..b], &centres, tris)
             } else {
                 let axis = (0..3)
                     .max_by(|&i, &j| (hi[i] - lo[i]).total_cmp(&(hi[j] - lo[j])))
                     .unwrap_or(0);
                 a + split_at_median(&mut order[a..b], &centres, axis)
             };
-            let left = self.nodes.len();
+            let left = nodes.len();
             for _ in 0..2 {
-                self.nodes.push(Node {
+                nodes.push(Node {
                     lo: [0.0; 3],
                     hi: [0.0; 3],
                     first: 0,
                     count: 0,
                 });
             }
-            self.nodes[node].first = left as u32;
-            self.nodes[node].count = 0;
+            nodes[node].first = left as u32;
+            nodes[node].count = 0;
             stack.push((left, a, mid, depth + 1));
             stack.push((left + 1, mid, b, depth + 1));
         }
         // Leaves index the triangles in `order`: store them so.
-        self.tris = order.iter().map(|&t| self.tris[t as usize]).collect();
+        let tris = order
+            .iter()
+            .map(|&t| Tri::from(&tris[t as usize]))
+            .collect();
+        (nodes, tris)
     }
 
     /// True if the segment from `a` to `b` comes closer than `limit` (mm) to some triangle.
@@ -218,7 +224,7 @@ impl SurfaceDistance {
             }
             let first = node.first as usize;
             for t in &self.tris[first..first + node.count as usize] {
-                if segment_triangle_distance(a, b, t) < limit {
+                if segment_triangle_distance(a, b, &t.corners()) < limit {
                     return true;
                 }
             }
@@ -257,12 +263,32 @@ impl SurfaceDistance {
             let first = node.first as usize;
             if let Some(p) = self.tris[first..first + node.count as usize]
                 .iter()
-                .find_map(|t| cyl.hit(t))
+                .find_map(|t| cyl.hit(&t.corners()))
             {
                 return Some(p);
             }
         }
         None
+    }
+}
+
+/// A triangle's corners in single precision (mm).
+#[derive(Debug, Clone, Copy)]
+struct Tri([[f32; 3]; 3]);
+
+impl Tri {
+    /// The corners in double precision.
+    #[inline]
+    fn corners(&self) -> [Point3; 3] {
+        self.0
+            .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
+    }
+}
+
+impl From<&[Point3; 3]> for Tri {
+    /// Rounds to single precision: exact for corners that came from single precision.
+    fn from(t: &[Point3; 3]) -> Self {
+        Tri(t.map(|q| [q.x as f32, q.y as f32, q.z as f32]))
     }
 }
 
@@ -767,7 +793,7 @@ mod tests {
             let brute = dist
                 .tris
                 .iter()
-                .any(|t| segment_triangle_distance(&a, &b, t) < limit);
+                .any(|t| segment_triangle_distance(&a, &b, &t.corners()) < limit);
             assert_eq!(dist.segment_within(&a, &b, limit), brute);
             agree += brute as usize;
         }
@@ -861,7 +887,7 @@ mod tests {
             let ends = (2.0 * rnd(), 2.0 + 10.0 * rnd());
             let rad = 0.1 + 3.0 * rnd();
             let cyl = Cylinder::new(&c, &axis, ends, rad);
-            let brute = dist.tris.iter().any(|t| cyl.hit(t).is_some());
+            let brute = dist.tris.iter().any(|t| cyl.hit(&t.corners()).is_some());
             assert_eq!(dist.cylinder_hit(&c, &axis, ends, rad).is_some(), brute);
             agree += brute as usize;
         }
