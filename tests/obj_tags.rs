@@ -275,15 +275,15 @@ fn tags_survive_the_json_format() {
     }
 }
 
-#[test]
-fn a_concave_sharp_crease_plans_without_gouges() {
-    // A V-shaped trough (tool side up) whose bottom line is an infinitely sharp crease: the
-    // surface is concave with a fold there that no ball fits. Without the tag the trough is
-    // smooth. The planner must lift the ball off both flanks; the simulation finds no gouge.
+/// A V-shaped trough (tool side up), flanks of `slope` either side of an infinitely sharp
+/// crease along x = 16 mm, z = 0, 24 mm long; planned at r 1 mm, h 0.02 mm and simulated.
+/// Returns the report, the simulation, and the least distance from the crease line to a ball
+/// centre less the radius: what is left at the bottom of the V (mm).
+fn v_trough(slope: f64) -> (tspath::plan::PlanReport, verify::Verification, f64) {
     let profile: Vec<(f64, f64)> = (0..9)
         .map(|i| {
             let x = 4.0 * i as f64;
-            (x, 0.35 * (x - 16.0).abs())
+            (x, slope * (x - 16.0).abs())
         })
         .collect();
     let sheet = support::extruded_obj(&profile, 4, 6.0, false);
@@ -305,21 +305,73 @@ fn a_concave_sharp_crease_plans_without_gouges() {
         verify::PLAN_VERIFY_MAX_SAMPLES,
     )
     .unwrap();
+    let bottom = planned
+        .toolpath
+        .moves
+        .iter()
+        .filter(|m| m.kind.on_surface())
+        .map(|m| (m.cl_point.x - 16.0).hypot(m.cl_point.z))
+        .fold(f64::INFINITY, f64::min)
+        - 1.0;
     println!(
-        "V trough with a sharp crease: {} patches, status {:?}, problems {:?}, max gouge {:.4} mm (tolerance {:.4}), max scallop {:.4} mm, bound {:.4} mm",
+        "V trough of slope {slope} with a sharp crease: {} patches, status {:?}, problems {:?}, left at the bottom {bottom:.5} mm, max gouge {:.4} mm (tolerance {:.4}), max scallop {:.4} mm, bound {:.4} mm, rest {:.5}",
         m.layout.patches.len(),
         report.status,
         report.problems.iter().map(|p| &p.kind).collect::<Vec<_>>(),
         v.max_gouge_mm,
         v.gouge_tolerance_mm,
         v.max_scallop_mm,
-        v.error_bound_mm
+        v.error_bound_mm,
+        v.rest_fraction
     );
+    (report, v, bottom)
+}
+
+#[test]
+fn a_concave_sharp_crease_plans_without_gouges() {
+    // The surface is concave with a fold at the crease that no ball fits. Without the tag
+    // the trough is smooth. The planner must lift the ball off both flanks; the simulation
+    // finds no gouge.
+    let slope: f64 = 0.35;
+    let (report, v, bottom) = v_trough(slope);
     // (Without the planner's crease handling the ball cuts 0.22 mm into the flanks.)
     assert_eq!(v.gouge_count, 0, "max gouge {} mm", v.max_gouge_mm);
-    // The bottom of the V is out of the ball's reach, and the plan says so.
+    // A ball touches both flanks, at a radius from each: it leaves r (1 / cos θ − 1) at the
+    // bottom (0.0595 mm), more than h, out of any ball's reach, and the plan says so.
+    let least = 1.0 / slope.atan().cos() - 1.0;
+    assert!(
+        (bottom - least).abs() < 1e-3,
+        "{bottom} mm left, {least} mm least"
+    );
     assert_eq!(report.status, PlanStatus::PlannedWithProblems);
     assert!(report.problems.iter().any(|p| p.kind == "rest_too_tight"));
+}
+
+#[test]
+fn a_shallow_concave_crease_is_cut_to_its_bottom() {
+    // Flanks of 8.5° either side: a ball touching both leaves r (1 / cos θ − 1) = 0.0112 mm
+    // at the bottom, under h. The balls lifted off the far flank slide down it until they
+    // touch their own again (lifted straight off it, they left 0.042 mm there and the plan
+    // reported the bottom as too tight for the ball).
+    let slope: f64 = 0.15;
+    let (report, v, bottom) = v_trough(slope);
+    let least = 1.0 / slope.atan().cos() - 1.0;
+    assert!(
+        (bottom - least).abs() < 1e-3,
+        "{bottom} mm left, {least} mm least"
+    );
+    assert_eq!(v.gouge_count, 0, "max gouge {} mm", v.max_gouge_mm);
+    assert!(
+        !report.problems.iter().any(|p| p.kind == "rest_too_tight"),
+        "{:?}",
+        report.problems
+    );
+    assert_eq!(v.rest_fraction, 0.0);
+    assert!(
+        v.max_scallop_mm + v.error_bound_mm <= 0.02,
+        "{} mm",
+        v.max_scallop_mm
+    );
 }
 
 fn opensubdiv_text(name: &str) -> String {

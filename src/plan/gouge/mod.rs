@@ -4,8 +4,9 @@
 //! creased inward (C0 knot lines, e.g. those a `.tsm` grip block puts in) or another part of
 //! the surface comes within the ball, that ball cuts into the neighbouring face. This module
 //! owns finding such CL points and lifting them clear: the ball centre moves away from the
-//! nearest surface point until it is a radius from every face, so it touches both sides of
-//! the crease. It must not move a CL point that gouges nothing (tolerance below), nor change
+//! nearest surface point until it is a radius from every face, and where that took it off
+//! its own side (a shallow concave crease) it slides down the other side until it touches
+//! its own again, so it touches both sides of the crease. It must not move a CL point that gouges nothing (tolerance below), nor change
 //! moves off the surface. Only balls near a spot where the surface is tighter than the ball,
 //! creased or singular ([`spots`]) are checked, against every face within reach there; where
 //! other parts of a smooth surface come within the ball (thin walls) is not looked for.
@@ -128,7 +129,7 @@ pub fn lift(
         // would take it to the far side, and the move to the next lifted point through.
         let away = m.cl_point - m.cc_point;
         let own_side = (m.kind == MoveKind::Plunge).then_some(away);
-        let Some(l) = near.nearest_from(&m.cl_point, r, &[]).and_then(|first| {
+        let Some(mut l) = near.nearest_from(&m.cl_point, r, &[]).and_then(|first| {
             lift_one(
                 &near,
                 m.cl_point,
@@ -143,6 +144,16 @@ pub fn lift(
         }) else {
             continue;
         };
+        // Lifted off a wall it cut into, the ball may have left its own contact: in a
+        // shallow concave crease the way off the other wall is mostly up. It slides down
+        // that wall until it touches its own side again, into the crease.
+        if let Some(n_own) = away.try_normalize(ON_SURFACE_SHARE * r).filter(|_| l.clear) {
+            if let Some((centre, contact)) =
+                settle(&near, (l.centre, l.contact), (m.cc_point, n_own), r, tol)
+            {
+                (l.centre, l.contact) = (centre, contact);
+            }
+        }
         lifted[i] = true;
         if let Some(x) = left.get_mut(i) {
             *x = ((l.centre - m.cc_point).norm() - r).max(0.0);
@@ -295,6 +306,40 @@ fn lift_one(
         contact: nearest.1,
         clear,
     })
+}
+
+/// The ball centred at `c`, touching the wall at `q` and clear of its own side's plane `own`
+/// (its contact point, unit normal) by more than `tol`, slid along the wall's plane until it
+/// is a radius from its own side's too (both planes' normals kept): the new centre and
+/// nearest surface point, if the ball there cuts in nowhere by more than `tol`. None where it
+/// already touches its own side, the two planes are near parallel, or the slide is longer
+/// than the ball's diameter (the walls are no planes at that scale).
+fn settle(
+    near: &Nearest,
+    (c, q): (Point3, Point3),
+    (cc, n_own): (Point3, Vector3),
+    r: f64,
+    tol: f64,
+) -> Option<(Point3, Point3)> {
+    let gap = (c - cc).dot(&n_own) - r;
+    let n_wall = (c - q).try_normalize(ON_SURFACE_SHARE * r)?;
+    let k = n_own.dot(&n_wall);
+    if gap <= tol || k.abs() > TWO_WALLS_COS {
+        return None;
+    }
+    // Along the wall's plane, straight towards the own side's plane: `t` (length² 1 − k²)
+    // brings the ball 1 − k² nearer it per unit.
+    let t = n_wall * k - n_own;
+    let slide = t * (gap / (1.0 - k * k));
+    if slide.norm() > 2.0 * r {
+        return None;
+    }
+    let settled = c + slide;
+    match near.nearest_from(&settled, r, &[]) {
+        Some((d, _)) if r - d > tol => None,
+        Some((_, contact)) => Some((settled, contact)),
+        None => Some((settled, q + slide)),
+    }
 }
 
 /// The step of a ball centred at `c` that takes it `depth` further along the unit normal `n`
