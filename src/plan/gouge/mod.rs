@@ -6,8 +6,8 @@
 //! owns finding such CL points and lifting them clear: the ball centre moves away from the
 //! nearest surface point until it is a radius from every face, and where that took it off
 //! its own side (a shallow concave crease) it slides down the other side until it touches
-//! its own again, so it touches both sides of the crease. It must not move a CL point that gouges nothing (tolerance below), nor change
-//! moves off the surface. Only balls near a spot where the surface is tighter than the ball,
+//! its own again, so it touches both sides of the crease. It must not move a CL point that
+//! gouges nothing (tolerance below), nor change moves off the surface. Only balls near a spot where the surface is tighter than the ball,
 //! creased or singular ([`spots`]) are checked, against every face within reach there; where
 //! other parts of a smooth surface come within the ball (thin walls) is not looked for.
 
@@ -327,8 +327,8 @@ fn settle(
     if gap <= tol || k.abs() > TWO_WALLS_COS {
         return None;
     }
-    // Along the wall's plane, straight towards the own side's plane: `t` (length² 1 − k²)
-    // brings the ball 1 − k² nearer it per unit.
+    // Along the wall's plane, straight towards the own side's plane: each multiple of `t`
+    // (length² 1 − k²) brings the ball 1 − k² nearer that plane.
     let t = n_wall * k - n_own;
     let slide = t * (gap / (1.0 - k * k));
     if slide.norm() > 2.0 * r {
