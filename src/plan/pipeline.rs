@@ -137,7 +137,7 @@ pub fn finish(
     };
     let n = draft.toolpath.moves.len();
     // Where balls were lifted, the material left around them, measured.
-    let tight = reach::tight_near_lifts(
+    let mut tight = reach::tight_near_lifts(
         model,
         &draft.toolpath,
         &draft.footprints,
@@ -148,11 +148,9 @@ pub fn finish(
     .ok_or(Error::Cancelled)?;
     // And points whose lifted ball leaves more than the scallop there: the material left is
     // not needed past this.
-    let tight: Vec<bool> = tight
-        .into_iter()
-        .zip(left)
-        .map(|(t, l)| t || l > opts.scallop_mm)
-        .collect();
+    for (t, l) in tight.iter_mut().zip(left) {
+        *t |= l > opts.scallop_mm;
+    }
     if !progress(GOUGE_PROGRESS + TIGHT_PROGRESS) {
         return Err(Error::Cancelled);
     }
@@ -185,13 +183,7 @@ pub fn finish(
     let along = reach::Along::of(&draft.toolpath.moves);
     let mut moves = std::mem::take(&mut draft.toolpath.moves);
     let mut params = std::mem::take(&mut draft.toolpath.params);
-    let mut left_out: Vec<(u32, [f64; 2])> = Vec::new();
-    if params.len() == n {
-        left_out = (0..n)
-            .filter(|&i| why[i].is_some() && along[i].kind.on_surface())
-            .map(|i| (i as u32, params[i]))
-            .collect();
-    }
+    let mut left_out = reach::left_out_params(&params, &along, &why);
     let (mut path, air, end_halves) = loop {
         let (mut path, origin) = reach::split_taking(moves, params, &draft, &why);
         // The half footprints at the cuts' ends, while the path is as split.

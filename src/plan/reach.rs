@@ -1087,6 +1087,23 @@ pub fn cut_end_halves(
     out
 }
 
+/// The params of the on-surface draft moves `skip` leaves out, by draft index (ascending), as
+/// [`cut_end_halves`] needs them: none where the draft has no params. `along` is
+/// [`Along::of`] the draft's moves.
+pub fn left_out_params(
+    params: &[[f64; 2]],
+    along: &[Along],
+    skip: &[Option<Why>],
+) -> Vec<(u32, [f64; 2])> {
+    if params.len() != along.len() {
+        return Vec::new();
+    }
+    (0..params.len())
+        .filter(|&i| skip[i].is_some() && along[i].kind.on_surface())
+        .map(|i| (i as u32, params[i]))
+        .collect()
+}
+
 /// The half of footprint `fp` of a point at params `p` towards a neighbour at `q` along its
 /// pass: cut at `p` across the parameter in which the neighbour lies farther.
 fn half_towards(fp: &Footprint, p: [f64; 2], q: [f64; 2]) -> Footprint {
@@ -1493,15 +1510,6 @@ mod tests {
         out
     }
 
-    /// The params of the on-surface moves `skip` leaves out, by draft index.
-    fn left_out_params(draft: &Draft, skip: &[Option<Why>]) -> Vec<(u32, [f64; 2])> {
-        let (moves, params) = (&draft.toolpath.moves, &draft.toolpath.params);
-        (0..params.len())
-            .filter(|&i| skip[i].is_some() && moves[i].kind.on_surface())
-            .map(|i| (i as u32, params[i]))
-            .collect()
-    }
-
     #[test]
     fn cut_end_halves_from_the_split_path_equal_those_from_the_draft() {
         // Random drafts with footprints round their params (some none), split; then split
@@ -1524,7 +1532,7 @@ mod tests {
             let along = Along::of(&draft.toolpath.moves);
             let (path, origin) = split(&draft, &skip);
             let want = cut_end_halves_of_draft(&draft, &skip);
-            let left_out = left_out_params(&draft, &skip);
+            let left_out = left_out_params(&draft.toolpath.params, &along, &skip);
             let got = cut_end_halves(&path, &origin, &draft.footprints, &along, &skip, &left_out);
             assert_eq!(got, want, "case {case}");
             halves += want.len();

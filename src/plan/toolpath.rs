@@ -162,16 +162,21 @@ impl RunSamples {
         if self.next < 3 {
             return;
         }
-        let dt = ACCELERATION_SAMPLE_S;
-        let velocity = |u: &Vector3, v: &Vector3| {
-            u.cross(v)
-                .try_normalize(f64::MIN_POSITIVE)
-                .map_or(Vector3::zeros(), |k| k * (u.angle(v).to_degrees() / dt))
-        };
         let w = &self.window;
-        let a = (velocity(&w[1], &w[2]) - velocity(&w[0], &w[1])).norm() / dt;
-        self.largest = self.largest.max(a);
+        self.largest = self.largest.max(angular_acceleration(w));
     }
+}
+
+/// The angular acceleration (deg/s²) of an axis sampled at `w`, [`ACCELERATION_SAMPLE_S`]
+/// apart: the change of its angular velocity from the first interval to the second.
+fn angular_acceleration(w: &[Vector3; 3]) -> f64 {
+    let dt = ACCELERATION_SAMPLE_S;
+    let velocity = |u: &Vector3, v: &Vector3| {
+        u.cross(v)
+            .try_normalize(f64::MIN_POSITIVE)
+            .map_or(Vector3::zeros(), |k| k * (u.angle(v).to_degrees() / dt))
+    };
+    (velocity(&w[1], &w[2]) - velocity(&w[0], &w[1])).norm() / dt
 }
 
 /// The unit vector a share `f` of the way from `u` to `v` on the great circle through them.
@@ -637,11 +642,6 @@ mod tests {
             let ((s0, u), (s1, v)) = (run[k - 1], run[k]);
             slerp(&u, &v, (t - s0) / (s1 - s0))
         };
-        let velocity = |u: &Vector3, v: &Vector3| {
-            u.cross(v)
-                .try_normalize(f64::MIN_POSITIVE)
-                .map_or(Vector3::zeros(), |k| k * (u.angle(v).to_degrees() / dt))
-        };
         let mut largest: f64 = 0.0;
         let mut runs: Vec<Vec<(f64, Vector3)>> = vec![Vec::new()];
         for w in path.moves.windows(2) {
@@ -667,8 +667,7 @@ mod tests {
                 .map(|k| axis_at(run, k as f64 * dt))
                 .collect();
             for w in samples.windows(3) {
-                let a = (velocity(&w[1], &w[2]) - velocity(&w[0], &w[1])).norm() / dt;
-                largest = largest.max(a);
+                largest = largest.max(angular_acceleration(&[w[0], w[1], w[2]]));
             }
         }
         largest
