@@ -18,16 +18,19 @@ const KEYS: &[&str] = &[
     "samples",
 ];
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("tspath-verify-cli-{}", std::process::id()));
+/// A scratch directory of one test (`cargo test` runs the tests of a file side by side in one
+/// process); each test removes its own when it passes.
+fn scratch(test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("tspath-verify-cli-{test}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    dir
 }
 
 #[test]
 fn gcode_from_plan_verifies_like_the_planned_path() {
-    let nc = tmp("dome.nc");
-    let report = tmp("report.json");
+    let dir = scratch("plan");
+    let nc = dir.join("dome.nc");
+    let report = dir.join("report.json");
     run(&args(&[
         "plan",
         "dome",
@@ -126,11 +129,13 @@ fn gcode_from_plan_verifies_like_the_planned_path() {
         b["error_bound_mm"]
     );
     assert!(num(&b, "samples") > 20000.0);
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn cl_json_input_and_errors() {
-    let cl = tmp("path.json");
+    let dir = scratch("cl-json");
+    let cl = dir.join("path.json");
     std::fs::write(
         &cl,
         r#"{"format": "tspath-cl", "tool_radius_mm": 0.5,
@@ -159,7 +164,7 @@ fn cl_json_input_and_errors() {
     assert!(e.contains("--tool-radius"), "{e}");
     let e = err(&["verify", "dome", cl.to_str().unwrap(), "--tool-radius", "1"]);
     assert!(e.contains("tool_radius_mm") && e.contains("0.5"), "{e}");
-    let bad = tmp("bad.nc");
+    let bad = dir.join("bad.nc");
     std::fs::write(
         &bad,
         "G21 G90\nG0 X0 Y0 Z30\nG1 X1 Y0 Z20 F100\nG2 X2 Y0 I1 J0\n",
@@ -185,4 +190,5 @@ fn cl_json_input_and_errors() {
     assert!(e.contains("samples"), "{e}");
     let e = err(&["verify", "dome", "/nonexistent.nc", "--tool-radius", "1"]);
     assert!(e.contains("cannot read"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
