@@ -482,6 +482,27 @@ impl Cylinder {
         self.axis_probe.meets(lo, hi, self.rad)
     }
 
+    /// True if the whole cylinder lies strictly to one side of the plane of the triangle
+    /// with corners `q` (in the cylinder's frame), so it cannot meet the triangle: a wall
+    /// running beside the shank a little more than its radius away is told so without
+    /// clipping. Both end discs are on the same side when the plane's value at their
+    /// centres exceeds the disc's reach across, `rad·|n⊥|` for the plane's normal `n` (its
+    /// part across the axis `n⊥`); compared squared. A triangle without area (`n` zero)
+    /// fails the comparison and is left to the full test.
+    fn beside_plane(&self, q: &[[f64; 3]; 3]) -> bool {
+        let (u, v) = (sub3(&q[1], &q[0]), sub3(&q[2], &q[0]));
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let across2 = n[1] * n[1] + n[2] * n[2];
+        let base = n[0] * q[0][0] + n[1] * q[0][1] + n[2] * q[0][2];
+        let (s0, s1) = (n[0] * self.a0 - base, n[0] * self.a1 - base);
+        let reach2 = self.rad * self.rad * across2;
+        (s0 > 0.0) == (s1 > 0.0) && s0 * s0 > reach2 && s1 * s1 > reach2
+    }
+
     /// A point of triangle `t` inside the cylinder, if there is one: the triangle clipped to
     /// the slab between the end planes, seen along the axis, comes within `rad` of it.
     fn hit(&self, t: &[Point3; 3]) -> Option<Point3> {
@@ -498,6 +519,9 @@ impl Cylinder {
             || q.iter().all(|v| v[2] > self.rad)
             || q.iter().all(|v| v[2] < -self.rad)
         {
+            return None;
+        }
+        if self.beside_plane(&q) {
             return None;
         }
         let mut poly = [[0.0; 3]; CLIPPED];
@@ -572,6 +596,12 @@ impl Cylinder {
             (w[1] * w[1] + w[2] * w[2] < rad2).then(|| at(w))
         })
     }
+}
+
+/// `a − b`.
+#[inline]
+fn sub3(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// Clips the convex polygon `poly[..n]` to where `side` is not negative (Sutherland–Hodgman);
@@ -872,6 +902,12 @@ mod tests {
         assert!(cyl([-1.0, 0.5, 0.5], x, (0.0, 5.0), 0.51).is_some());
         // Ending before the triangle starts (x < 0): no hit however wide.
         assert!(cyl([-3.0, 0.5, 0.0], x, (0.0, 2.9), 5.0).is_none());
+        // Leaning 10° over the triangle, its lower end `h` above it: the end disc reaches
+        // down by `rad·cos 10°` = 0.29544 mm at a point over the triangle (a wall beside a
+        // tilted shank, which the plane test tells apart without clipping).
+        let lean = Vector3::new(10f64.to_radians().cos(), 0.0, 10f64.to_radians().sin());
+        assert!(cyl([0.2, 0.5, 0.2953], lean, (0.0, 1.0), 0.3).is_some());
+        assert!(cyl([0.2, 0.5, 0.2956], lean, (0.0, 1.0), 0.3).is_none());
     }
 
     #[test]
