@@ -44,6 +44,21 @@ pub(super) fn usable(
     axis.dot(n) >= MIN_AXIS_NORMAL_COS && obs.clear(c, axis, opts)
 }
 
+/// [`usable`], with the holder tested only if `holder` (else the shank only).
+fn usable_by(
+    obs: &Clearance,
+    (c, n): (&Point3, &Vector3),
+    axis: &Vector3,
+    opts: &PlanOptions,
+    holder: bool,
+) -> bool {
+    if holder {
+        usable(obs, (c, n), axis, opts)
+    } else {
+        axis.dot(n) >= MIN_AXIS_NORMAL_COS && obs.shank_clear(c, axis, opts)
+    }
+}
+
 /// The sample the vertical tool at ball centre `c` hits, or the contact point `cc` itself
 /// where the surface faces away from +Z.
 fn vertical_hit(
@@ -272,14 +287,17 @@ pub struct AxisStats {
 /// of the checked poses to hold the tool in between) puts the shank or holder into the
 /// model.
 pub(super) fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptions) -> bool {
-    let poses = obs.sweep_poses(
+    let counts = obs.sweep_poses(
         (&a.cl_point, &a.tool_axis),
         (&b.cl_point, &b.tool_axis),
         opts,
     );
+    let poses = counts.shank.max(counts.holder);
     if poses <= 1 {
         return false;
     }
+    // Where the holder needs no pose between the ends (they are checked), the shank alone.
+    let holder = counts.holder > 1;
     let (na, nb) = (contact_normal(a), contact_normal(b));
     (1..poses).any(|k| {
         let s = k as f64 / poses as f64;
@@ -288,7 +306,7 @@ pub(super) fn turn_blocked(a: &Move, b: &Move, obs: &Clearance, opts: &PlanOptio
             .try_normalize(AXIS_MIN_NORM)
             .unwrap_or(nb);
         match (a.tool_axis * (1.0 - s) + b.tool_axis * s).try_normalize(AXIS_MIN_NORM) {
-            Some(axis) => !usable(obs, (&c, &n), &axis, opts),
+            Some(axis) => !usable_by(obs, (&c, &n), &axis, opts, holder),
             // Opposite axes: no defined turn, count it.
             None => true,
         }

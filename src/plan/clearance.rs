@@ -121,36 +121,49 @@ impl Clearance {
     ///   farther along) (for the holder, whose rim overhangs the
     ///   shank below it; the shank's rim overhangs nothing checked unless it is wider than
     ///   the flutes).
+    ///
+    /// Counted for each cylinder: each needs only its own poses, as the tool in between lies
+    /// inside the grown cylinders of the checked poses cylinder by cylinder (the shank's top
+    /// moving along its axis stays inside the holder, whose own poses hold it).
     pub fn sweep_poses(
         &self,
         (c0, a0): (&Point3, &Vector3),
         (c1, a1): (&Point3, &Vector3),
         opts: &PlanOptions,
-    ) -> usize {
+    ) -> SweepPoses {
         let d = c1 - c0;
         let turn = a0.angle(a1);
         let shank_top = opts.shank_length_mm;
-        sweep_poses(
-            (d.norm(), d.dot(a0).abs().max(d.dot(a1).abs())),
-            turn * blend_speed_up(turn),
-            &[
-                Swept {
-                    top: shank_top,
-                    rad: opts.shank_radius(),
-                    g: self.shank.tolerance_mm,
-                    // The shank's ends move into the flutes below (unchecked: they cut) and
-                    // the holder above (checked, and wider): only a shank wider than the
-                    // flutes shows a rim below.
-                    ends: opts.shank_radius() > opts.tool_radius_mm,
-                },
-                Swept {
-                    top: shank_top + opts.holder_length_mm,
-                    rad: opts.holder_radius_mm,
-                    g: self.holder().tolerance_mm,
-                    ends: true,
-                },
-            ],
-        )
+        let poses = |cylinder: Swept| {
+            sweep_poses(
+                (d.norm(), d.dot(a0).abs().max(d.dot(a1).abs())),
+                turn * blend_speed_up(turn),
+                std::slice::from_ref(&cylinder),
+            )
+        };
+        SweepPoses {
+            shank: poses(Swept {
+                top: shank_top,
+                rad: opts.shank_radius(),
+                g: self.shank.tolerance_mm,
+                // The shank's ends move into the flutes below (unchecked: they cut) and the
+                // holder above (checked, and wider): only a shank wider than the flutes
+                // shows a rim below.
+                ends: opts.shank_radius() > opts.tool_radius_mm,
+            }),
+            holder: poses(Swept {
+                top: shank_top + opts.holder_length_mm,
+                rad: opts.holder_radius_mm,
+                g: self.holder().tolerance_mm,
+                ends: true,
+            }),
+        }
+    }
+
+    /// True if the shank at `c` along `axis` is clear of the model (the holder untested).
+    pub fn shank_clear(&self, c: &Point3, axis: &Vector3, opts: &PlanOptions) -> bool {
+        let [shank, _] = self.cylinders(opts);
+        shank.hit(c, axis).is_none()
     }
 
     /// True if the shank and holder at `c` along `axis` are clear of the model.
@@ -172,6 +185,14 @@ impl Clearance {
         }
         true
     }
+}
+
+/// Poses a move needs checked (counting its end), per cylinder: see
+/// [`Clearance::sweep_poses`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SweepPoses {
+    pub shank: usize,
+    pub holder: usize,
 }
 
 /// A cylinder of the tool above the ball centre (mm) and the triangles it is tested
