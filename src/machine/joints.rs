@@ -142,27 +142,26 @@ fn allowed(
     (p, before): (&PoseRequest, Option<&PoseRequest>),
     i: usize,
     from: &State,
-) -> Result<Vec<RotarySolution>> {
+    out: &mut Vec<RotarySolution>,
+) -> Result<()> {
     let Some(before) = before.filter(|_| !p.starts_chain) else {
         return machine
-            .rotary_solutions(&p.axis, from.rotary_deg, true)
+            .rotary_solutions_into(&p.axis, from.rotary_deg, true, out)
             .map_err(|Unreachable| unreachable(machine, i, &p.axis));
     };
-    let free = machine
-        .rotary_solutions(&p.axis, from.rotary_deg, false)
+    machine
+        .rotary_solutions_into(&p.axis, from.rotary_deg, false, out)
         .map_err(|Unreachable| unreachable(machine, i, &p.axis))?;
-    let least = free
+    let least = out
         .iter()
         .map(|s| distance(s.rotary_deg, from.rotary_deg))
         .fold(f64::INFINITY, f64::min);
     let continuation = from.branch.is_some() && !machine.arc_meets_singular(&before.axis, &p.axis);
-    Ok(free
-        .into_iter()
-        .filter(|s| {
-            distance(s.rotary_deg, from.rotary_deg) <= least + STEP_TIE_DEG
-                || (continuation && (s.singular || Some(s.branch) == from.branch))
-        })
-        .collect())
+    out.retain(|s| {
+        distance(s.rotary_deg, from.rotary_deg) <= least + STEP_TIE_DEG
+            || (continuation && (s.singular || Some(s.branch) == from.branch))
+    });
+    Ok(())
 }
 
 /// The tool tip of move `i` of `path` (the ball centre less the radius along the axis).
@@ -237,11 +236,13 @@ pub fn solve_rotaries_by(
     let mut sizes: Vec<u16> = Vec::with_capacity(n);
     let (mut from, mut next): (Vec<State>, Vec<State>) = (vec![home], Vec::new());
     let mut before: Option<PoseRequest> = None;
+    let mut solutions = Vec::new();
     for i in 0..n {
         let p = pose(i);
         next.clear();
         for (k, f) in from.iter().enumerate() {
-            for s in allowed(machine, (&p, before.as_ref()), i, f)? {
+            allowed(machine, (&p, before.as_ref()), i, f, &mut solutions)?;
+            for s in &solutions {
                 let Some(rotary_deg) = machine.within_limits(s.rotary_deg) else {
                     continue;
                 };

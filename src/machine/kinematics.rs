@@ -513,13 +513,29 @@ impl Machine {
         previous: [f64; 2],
         respect_limits: bool,
     ) -> std::result::Result<Vec<RotarySolution>, Unreachable> {
+        let mut out = Vec::new();
+        self.rotary_solutions_into(axis, previous, respect_limits, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::rotary_solutions`] into `out` (cleared first): the joint solve asks for them
+    /// at every state of every move, and a vector each was most of its allocations.
+    pub fn rotary_solutions_into(
+        &self,
+        axis: &Vector3,
+        previous: [f64; 2],
+        respect_limits: bool,
+        out: &mut Vec<RotarySolution>,
+    ) -> std::result::Result<(), Unreachable> {
+        out.clear();
         if self.rotaries.len() != 2 {
             return if (axis - Vector3::z()).norm() <= SINGULAR_CONE_RAD {
-                Ok(vec![RotarySolution {
+                out.push(RotarySolution {
                     rotary_deg: [0.0; 2],
                     branch: 0,
                     singular: false,
-                }])
+                });
+                Ok(())
             } else {
                 Err(Unreachable)
             };
@@ -539,7 +555,6 @@ impl Machine {
         }
         let gamma = g2.max(0.0).sqrt();
         let singular = (v - f.b2 * k2).norm() < SINGULAR_CONE_RAD;
-        let mut out = Vec::new();
         for (branch, sgn) in [(0u8, 1.0), (1u8, -1.0)] {
             if branch == 1 && (singular || gamma == 0.0) {
                 break;
@@ -570,25 +585,27 @@ impl Machine {
             if (back - v).norm() > 2.0 * SINGULAR_CONE_RAD + ORIENTATION_RESIDUAL_RAD {
                 return Err(Unreachable);
             }
-            // Every turn of each axis that the limits allow (endless: nearest previous).
-            let turns = |i: usize| -> Vec<f64> {
+            // Every turn of each axis that the limits allow (endless, or limits ignored:
+            // the turn nearest previous).
+            let turns = |i: usize| {
                 let r = &self.rotaries[i];
-                match r.limits_deg {
-                    Some(_) if !respect_limits => vec![nearest_turn(deg[i], previous[i])],
-                    None => vec![nearest_turn(deg[i], previous[i])],
-                    Some((lo, hi)) => {
-                        let mut t = Vec::new();
-                        let kmin = ((lo - deg[i]) / 360.0).floor() as i64;
-                        let kmax = ((hi - deg[i]) / 360.0).ceil() as i64;
-                        for k in kmin..=kmax {
-                            let a = deg[i] + 360.0 * k as f64;
-                            if r.within(a) {
-                                t.push(a.clamp(lo, hi));
-                            }
-                        }
-                        t
-                    }
-                }
+                let limits = r.limits_deg.filter(|_| respect_limits);
+                let nearest = limits.is_none().then(|| nearest_turn(deg[i], previous[i]));
+                let (lo, hi) = limits.unwrap_or((0.0, 0.0));
+                // An empty range without limits.
+                let (kmin, kmax) = match limits {
+                    Some(_) => (
+                        ((lo - deg[i]) / 360.0).floor() as i64,
+                        ((hi - deg[i]) / 360.0).ceil() as i64,
+                    ),
+                    None => (1, 0),
+                };
+                nearest
+                    .into_iter()
+                    .chain((kmin..=kmax).filter_map(move |k| {
+                        let a = deg[i] + 360.0 * k as f64;
+                        r.within(a).then(|| a.clamp(lo, hi))
+                    }))
             };
             for a0 in turns(0) {
                 for a1 in turns(1) {
@@ -600,7 +617,7 @@ impl Machine {
                 }
             }
         }
-        Ok(out)
+        Ok(())
     }
 
     /// Checks linear joint values against the travel; the error names the axis and value.
