@@ -41,10 +41,10 @@ pub(super) fn usable(
     axis: &Vector3,
     opts: &PlanOptions,
 ) -> bool {
-    axis.dot(n) >= MIN_AXIS_NORMAL_COS && obs.clear(c, axis, opts)
+    usable_by(obs, (c, n), axis, opts, true)
 }
 
-/// [`usable`], with the holder tested only if `holder` (else the shank only).
+/// [`usable`], with the holder tested only if `holder` (else the shank alone).
 fn usable_by(
     obs: &Clearance,
     (c, n): (&Point3, &Vector3),
@@ -52,11 +52,12 @@ fn usable_by(
     opts: &PlanOptions,
     holder: bool,
 ) -> bool {
-    if holder {
-        usable(obs, (c, n), axis, opts)
-    } else {
-        axis.dot(n) >= MIN_AXIS_NORMAL_COS && obs.shank_clear(c, axis, opts)
-    }
+    axis.dot(n) >= MIN_AXIS_NORMAL_COS
+        && if holder {
+            obs.clear(c, axis, opts)
+        } else {
+            obs.shank_clear(c, axis, opts)
+        }
 }
 
 /// The sample the vertical tool at ball centre `c` hits, or the contact point `cc` itself

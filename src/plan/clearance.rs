@@ -191,7 +191,9 @@ impl Clearance {
 /// [`Clearance::sweep_poses`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SweepPoses {
+    /// For the shank (above the flutes).
     pub shank: usize,
+    /// For the holder.
     pub holder: usize,
 }
 
