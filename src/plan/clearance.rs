@@ -132,15 +132,11 @@ impl Clearance {
         opts: &PlanOptions,
     ) -> SweepPoses {
         let d = c1 - c0;
+        let motion = (d.norm(), d.dot(a0).abs().max(d.dot(a1).abs()));
         let turn = a0.angle(a1);
+        let turn = turn * blend_speed_up(turn);
         let shank_top = opts.shank_length_mm;
-        let poses = |cylinder: Swept| {
-            sweep_poses(
-                (d.norm(), d.dot(a0).abs().max(d.dot(a1).abs())),
-                turn * blend_speed_up(turn),
-                std::slice::from_ref(&cylinder),
-            )
-        };
+        let poses = |cylinder: Swept| sweep_poses(motion, turn, &cylinder);
         SweepPoses {
             shank: poses(Swept {
                 top: shank_top,
@@ -228,20 +224,14 @@ struct Swept {
 
 /// Poses for a move of `travel` mm (`along` of it along the axis) turning `turn` radians:
 /// see [`Clearance::sweep_poses`].
-fn sweep_poses((travel, along): (f64, f64), turn: f64, cylinders: &[Swept]) -> usize {
-    cylinders
-        .iter()
-        .map(|c| {
-            let sideways = (travel + c.top * turn) / (2.0 * (2.0 * c.rad * c.g + c.g * c.g).sqrt());
-            let lengthways = if c.ends {
-                (along + c.rad * turn) / c.g
-            } else {
-                0.0
-            };
-            sideways.max(lengthways)
-        })
-        .fold(1.0, f64::max)
-        .ceil() as usize
+fn sweep_poses((travel, along): (f64, f64), turn: f64, c: &Swept) -> usize {
+    let sideways = (travel + c.top * turn) / (2.0 * (2.0 * c.rad * c.g + c.g * c.g).sqrt());
+    let lengthways = if c.ends {
+        (along + c.rad * turn) / c.g
+    } else {
+        0.0
+    };
+    sideways.max(lengthways).max(1.0).ceil() as usize
 }
 
 /// How much faster than on average the axis turns at the middle of a linear blend of two
@@ -364,12 +354,12 @@ mod tests {
             let poses = sweep_poses(
                 (travel, 0.0),
                 turn,
-                &[Swept {
+                &Swept {
                     top,
                     rad,
                     g,
                     ends: false,
-                }],
+                },
             );
             let dir = Vector3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize();
             // The axis turns about +Y from +Z while the ball centre moves along `dir`.
@@ -441,7 +431,7 @@ mod tests {
                 .dot(&a0)
                 .abs()
                 .max((dir * travel).dot(&a1).abs());
-            let poses = sweep_poses((travel, along), turn, std::slice::from_ref(&holder));
+            let poses = sweep_poses((travel, along), turn, &holder);
             let inside = |p: &Point3, (e, a): &(Point3, Vector3)| {
                 let d = p - e;
                 let h = d.dot(a);

@@ -7,9 +7,10 @@
 //! nearest surface point until it is a radius from every face, and where that took it off
 //! its own side (a shallow concave crease) it slides down the other side until it touches
 //! its own again, so it touches both sides of the crease. It must not move a CL point that
-//! gouges nothing (tolerance below), nor change moves off the surface. Only balls near a spot where the surface is tighter than the ball,
-//! creased or singular ([`spots`]) are checked, against every face within reach there; where
-//! other parts of a smooth surface come within the ball (thin walls) is not looked for.
+//! gouges nothing (tolerance below), nor change moves off the surface. Only balls near a
+//! spot where the surface is tighter than the ball, creased or singular ([`spots`]) are
+//! checked, against every face within reach there; where other parts of a smooth surface
+//! come within the ball (thin walls) is not looked for.
 
 mod nearest;
 mod spots;
