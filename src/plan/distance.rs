@@ -13,7 +13,8 @@ use std::sync::{Arc, Mutex};
 /// Triangles per leaf of the hierarchy.
 const LEAF: usize = 8;
 
-/// A node: its box, and either two children or a range of triangles.
+/// A node of the binary hierarchy as built: its box, and either two children or a range of
+/// triangles.
 #[derive(Debug, Clone, Copy)]
 struct Node {
     lo: [f64; 3],
@@ -23,12 +24,41 @@ struct Node {
     count: u32,
 }
 
+/// Children of a node of the query hierarchy.
+const WIDE: usize = 4;
+
+/// A node of the query hierarchy: the binary hierarchy with every second level folded into
+/// its parent, so a node holds up to four children (its children's children, or a child
+/// that is a leaf), left to right as in the binary one. The boxes lie coordinate by
+/// coordinate, one lane a child, so one test runs over all four side by side.
+#[derive(Debug, Clone, Copy)]
+struct Wide {
+    lo: [[f64; WIDE]; 3],
+    hi: [[f64; WIDE]; 3],
+    /// Per child: the node's index, or the leaf's first triangle.
+    link: [u32; WIDE],
+    /// Per child: 0 for a node, else the leaf's triangle count.
+    count: [u32; WIDE],
+    /// Children in use (the first `len`).
+    len: u32,
+}
+
+impl Wide {
+    const EMPTY: Wide = Wide {
+        lo: [[0.0; WIDE]; 3],
+        hi: [[0.0; WIDE]; 3],
+        link: [0; WIDE],
+        count: [0; WIDE],
+        len: 0,
+    };
+}
+
 /// The surface's triangles in a hierarchy of boxes.
 pub struct SurfaceDistance {
     /// The triangles in the leaves' order, in single precision: the tessellation's
     /// positions are single precision, so this holds them exactly in half the memory.
     tris: Vec<Tri>,
-    nodes: Vec<Node>,
+    nodes: Vec<Wide>,
     /// Largest distance between the triangles and the surface (mm).
     pub tolerance_mm: f64,
 }
@@ -140,8 +170,14 @@ impl SurfaceDistance {
         }
     }
 
-    /// The hierarchy over `tris`, and the triangles in its leaves' order.
-    fn build(tris: &[[Point3; 3]]) -> (Vec<Node>, Vec<Tri>) {
+    /// The query hierarchy over `tris`, and the triangles in its leaves' order.
+    fn build(tris: &[[Point3; 3]]) -> (Vec<Wide>, Vec<Tri>) {
+        let (nodes, tris) = Self::build_binary(tris);
+        (widen(&nodes), tris)
+    }
+
+    /// The binary hierarchy over `tris`, and the triangles in its leaves' order.
+    fn build_binary(tris: &[[Point3; 3]]) -> (Vec<Node>, Vec<Tri>) {
         let n = tris.len();
         if n == 0 {
             return (Vec::new(), Vec::new());
@@ -211,25 +247,11 @@ impl SurfaceDistance {
             return false;
         }
         let probe = BoxProbe::new(a, b);
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
-            let node = self.nodes[i];
-            if !probe.meets(&node.lo, &node.hi, limit) {
-                continue;
-            }
-            if node.count == 0 {
-                stack.push(node.first as usize);
-                stack.push(node.first as usize + 1);
-                continue;
-            }
-            let first = node.first as usize;
-            for t in &self.tris[first..first + node.count as usize] {
-                if segment_triangle_distance(a, b, &t.corners()) < limit {
-                    return true;
-                }
-            }
-        }
-        false
+        self.leaves_meeting(
+            |n: &Wide| probe.meets4(n, limit),
+            |t: &Tri| (segment_triangle_distance(a, b, &t.corners()) < limit).then_some(()),
+        )
+        .is_some()
     }
 
     /// A point of a triangle inside the flat-ended cylinder of radius `rad` along unit
@@ -246,30 +268,99 @@ impl SurfaceDistance {
             return None;
         }
         let cyl = Cylinder::new(c, axis, (a0, a1), rad);
-        let mut stack = [0u32; MAX_DEPTH];
+        self.leaves_meeting(|n: &Wide| cyl.may_meet4(n), |t: &Tri| cyl.hit(&t.corners()))
+    }
+
+    /// The first `Some` of `test` over the triangles, in the leaves' order, of the leaves
+    /// whose boxes and their nodes' boxes `meets` does not rule out (a lane false: the
+    /// child's box surely holds no triangle `test` would take).
+    #[inline]
+    fn leaves_meeting<T>(
+        &self,
+        meets: impl Fn(&Wide) -> [bool; WIDE],
+        test: impl Fn(&Tri) -> Option<T>,
+    ) -> Option<T> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        // (link, count) as in [`Wide`]: a node, or a leaf's triangles.
+        let mut stack = [(0u32, 0u32); STACK];
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let node = self.nodes[stack[top] as usize];
-            if !cyl.may_meet(&node.lo, &node.hi) {
+            let (link, count) = stack[top];
+            if count == 0 {
+                let node = &self.nodes[link as usize];
+                let ok = meets(node);
+                // Pushed right to left, so the leftmost is taken first.
+                for j in (0..node.len as usize).rev() {
+                    if ok[j] {
+                        stack[top] = (node.link[j], node.count[j]);
+                        top += 1;
+                    }
+                }
                 continue;
             }
-            if node.count == 0 {
-                stack[top] = node.first + 1;
-                stack[top + 1] = node.first;
-                top += 2;
-                continue;
-            }
-            let first = node.first as usize;
-            if let Some(p) = self.tris[first..first + node.count as usize]
+            let first = link as usize;
+            if let Some(p) = self.tris[first..first + count as usize]
                 .iter()
-                .find_map(|t| cyl.hit(&t.corners()))
+                .find_map(&test)
             {
                 return Some(p);
             }
         }
         None
     }
+}
+
+/// The query hierarchy of the binary one `nodes` (root first): each node's children are its
+/// binary node's grandchildren, or a child where that is a leaf; the root is the binary
+/// root's node (its own box is not tested: its children's are).
+fn widen(nodes: &[Node]) -> Vec<Wide> {
+    if nodes.is_empty() {
+        return Vec::new();
+    }
+    let mut wide = vec![Wide::EMPTY];
+    // (wide node, the binary node it stands for)
+    let mut todo = vec![(0usize, 0usize)];
+    while let Some((w, b)) = todo.pop() {
+        let node = nodes[b];
+        let mut kids = [0usize; WIDE];
+        let mut len = 0;
+        if node.count != 0 {
+            // A root that is a leaf.
+            kids[0] = b;
+            len = 1;
+        } else {
+            for c in [node.first as usize, node.first as usize + 1] {
+                if nodes[c].count != 0 {
+                    kids[len] = c;
+                    len += 1;
+                } else {
+                    kids[len] = nodes[c].first as usize;
+                    kids[len + 1] = nodes[c].first as usize + 1;
+                    len += 2;
+                }
+            }
+        }
+        wide[w].len = len as u32;
+        for (j, &k) in kids[..len].iter().enumerate() {
+            let child = nodes[k];
+            for q in 0..3 {
+                wide[w].lo[q][j] = child.lo[q];
+                wide[w].hi[q][j] = child.hi[q];
+            }
+            if child.count != 0 {
+                wide[w].link[j] = child.first;
+                wide[w].count[j] = child.count;
+            } else {
+                wide[w].link[j] = wide.len() as u32;
+                wide.push(Wide::EMPTY);
+                todo.push((wide.len() - 1, k));
+            }
+        }
+    }
+    wide
 }
 
 /// A triangle's corners in single precision (mm).
@@ -407,8 +498,11 @@ fn split_at_median(order: &mut [u32], centres: &[Vector3], axis: usize) -> usize
 /// Depth to which nodes are split by area; below it, at the median (at most 30 levels more
 /// for 2³² triangles, eight a leaf).
 const AREA_DEPTH: usize = 30;
-/// Deepest the hierarchy gets, and the query stack's size.
+/// Deepest the binary hierarchy gets.
 const MAX_DEPTH: usize = AREA_DEPTH + 34;
+/// The query stack's size: a query holds at most the untaken children (`WIDE − 1`) of each
+/// level of the query hierarchy (half the binary one's) and the one node it takes.
+const STACK: usize = (WIDE - 1) * (MAX_DEPTH / 2 + 1) + 1;
 
 /// A flat-ended cylinder in its own frame: the axis through `c` along unit `axis`, `e1` and
 /// `e2` across it.
@@ -453,33 +547,38 @@ impl Cylinder {
         }
     }
 
-    /// False if the box from `lo` to `hi` surely misses the cylinder: it lies beyond an end
+    /// Per child of `n`: false if its box surely misses the cylinder: it lies beyond an end
     /// plane, its bounding sphere is farther than `rad` from the axis, or the axis segment
-    /// misses the box grown by `rad`.
-    fn may_meet(&self, lo: &[f64; 3], hi: &[f64; 3]) -> bool {
-        let (mut mid, mut half, mut d2, mut r2) = (0.0, 0.0, 0.0, 0.0);
-        let mut d = [0.0; 3];
+    /// misses the box grown by `rad`. The four lanes side by side (the compiler pairs them).
+    #[inline]
+    fn may_meet4(&self, n: &Wide) -> [bool; WIDE] {
+        let (mut mid, mut half, mut r2) = ([0.0; WIDE], [0.0; WIDE], [0.0; WIDE]);
+        let mut d = [[0.0; WIDE]; 3];
         for k in 0..3 {
-            d[k] = 0.5 * (lo[k] + hi[k]) - self.c[k];
-            let e = 0.5 * (hi[k] - lo[k]);
-            mid += d[k] * self.axis[k];
-            half += e * self.axis_abs[k];
-            r2 += e * e;
+            for j in 0..WIDE {
+                d[k][j] = 0.5 * (n.lo[k][j] + n.hi[k][j]) - self.c[k];
+                let e = 0.5 * (n.hi[k][j] - n.lo[k][j]);
+                mid[j] += d[k][j] * self.axis[k];
+                half[j] += e * self.axis_abs[k];
+                r2[j] += e * e;
+            }
         }
-        if mid + half < self.a0 || mid - half > self.a1 {
-            return false;
-        }
+        let mut ok = self.axis_probe.meets4(n, self.rad);
+        let mut d2 = [0.0; WIDE];
         for k in 0..3 {
-            let x = d[k] - mid * self.axis[k];
-            d2 += x * x;
+            for j in 0..WIDE {
+                let x = d[k][j] - mid[j] * self.axis[k];
+                d2[j] += x * x;
+            }
         }
-        // Within `rad` plus the box's half diagonal of the axis: d² ≤ (rad + √r2)².
-        let over = d2 - self.rad * self.rad - r2;
-        if over > 0.0 && over * over > self.four_rad2 * r2 {
-            return false;
+        for j in 0..WIDE {
+            let beyond = (mid[j] + half[j] < self.a0) | (mid[j] - half[j] > self.a1);
+            // Within `rad` plus the box's half diagonal of the axis: d² ≤ (rad + √r2)².
+            let over = d2[j] - self.rad * self.rad - r2[j];
+            let far = (over > 0.0) & (over * over > self.four_rad2 * r2[j]);
+            ok[j] &= !beyond & !far;
         }
-        // The axis segment against the box grown by the radius.
-        self.axis_probe.meets(lo, hi, self.rad)
+        ok
     }
 
     /// True if the whole cylinder lies strictly to one side of the plane of the triangle
@@ -652,26 +751,28 @@ impl BoxProbe {
         }
     }
 
-    /// True if the segment comes within `grow` of the box (tested against the box grown by
-    /// `grow` on every side, which contains that neighbourhood).
-    fn meets(&self, lo: &[f64; 3], hi: &[f64; 3], grow: f64) -> bool {
-        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    /// Per child of `n`: true if the segment comes within `grow` of its box (tested against
+    /// the box grown by `grow` on every side, which contains that neighbourhood).
+    #[inline]
+    fn meets4(&self, n: &Wide, grow: f64) -> [bool; WIDE] {
+        let (mut t0, mut t1) = ([0.0f64; WIDE], [1.0f64; WIDE]);
+        let mut ok = [true; WIDE];
         for k in 0..3 {
-            let (l, h) = (lo[k] - grow, hi[k] + grow);
-            if self.inv[k].is_infinite() {
-                if self.a[k] < l || self.a[k] > h {
-                    return false;
+            for j in 0..WIDE {
+                let (l, h) = (n.lo[k][j] - grow, n.hi[k][j] + grow);
+                if self.inv[k].is_infinite() {
+                    ok[j] &= (self.a[k] >= l) & (self.a[k] <= h);
+                } else {
+                    let (u, v) = ((l - self.a[k]) * self.inv[k], (h - self.a[k]) * self.inv[k]);
+                    t0[j] = most(t0[j], least(u, v));
+                    t1[j] = least(t1[j], most(u, v));
                 }
-                continue;
-            }
-            let (u, v) = ((l - self.a[k]) * self.inv[k], (h - self.a[k]) * self.inv[k]);
-            t0 = most(t0, least(u, v));
-            t1 = least(t1, most(u, v));
-            if t0 > t1 {
-                return false;
             }
         }
-        true
+        for j in 0..WIDE {
+            ok[j] &= t0[j] <= t1[j];
+        }
+        ok
     }
 }
 
@@ -923,9 +1024,11 @@ mod tests {
             let ends = (2.0 * rnd(), 2.0 + 10.0 * rnd());
             let rad = 0.1 + 3.0 * rnd();
             let cyl = Cylinder::new(&c, &axis, ends, rad);
-            let brute = dist.tris.iter().any(|t| cyl.hit(&t.corners()).is_some());
-            assert_eq!(dist.cylinder_hit(&c, &axis, ends, rad).is_some(), brute);
-            agree += brute as usize;
+            // The hit the hierarchy returns is the first in the leaves' order (callers lean
+            // the tool away from it, so the order decides the plan).
+            let brute = dist.tris.iter().find_map(|t| cyl.hit(&t.corners()));
+            assert_eq!(dist.cylinder_hit(&c, &axis, ends, rad), brute);
+            agree += brute.is_some() as usize;
         }
         assert!(agree > 40 && agree < 360, "{agree} of 400 cylinders hit");
     }
