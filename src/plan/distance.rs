@@ -563,7 +563,6 @@ impl Cylinder {
                 r2[j] += e * e;
             }
         }
-        let mut ok = self.axis_probe.meets4(n, self.rad);
         let mut d2 = [0.0; WIDE];
         for k in 0..3 {
             for j in 0..WIDE {
@@ -571,12 +570,20 @@ impl Cylinder {
                 d2[j] += x * x;
             }
         }
+        let mut ok = [false; WIDE];
         for j in 0..WIDE {
             let beyond = (mid[j] + half[j] < self.a0) | (mid[j] - half[j] > self.a1);
             // Within `rad` plus the box's half diagonal of the axis: d² ≤ (rad + √r2)².
             let over = d2[j] - self.rad * self.rad - r2[j];
             let far = (over > 0.0) & (over * over > self.four_rad2 * r2[j]);
-            ok[j] &= !beyond & !far;
+            ok[j] = !beyond & !far;
+        }
+        // The axis segment against the boxes grown by the radius, unless all are out.
+        if ok != [false; WIDE] {
+            let probe = self.axis_probe.meets4(n, self.rad);
+            for j in 0..WIDE {
+                ok[j] &= probe[j];
+            }
         }
         ok
     }
