@@ -8,6 +8,28 @@ pub type Vector3 = nalgebra::Vector3<f64>;
 /// A homogeneous control point `(w x, w y, w z, w)`.
 pub type Vector4 = nalgebra::Vector4<f64>;
 
+/// The smaller of two numbers that are not NaN, by a plain comparison: `f64::min` is a
+/// call in wasm (for its NaN rule), and the hierarchy's queries and the simulation's bounds
+/// take millions. Where `b` is NaN, `a`, as `f64::min` does; folds start from a number.
+#[inline]
+pub fn least(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The larger of two numbers that are not NaN (see [`least`]).
+#[inline]
+pub fn most(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 /// An axis-aligned bounding box in millimetres.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Aabb {

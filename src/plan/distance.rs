@@ -6,7 +6,7 @@
 //! shank and holder). Must not: know what the segments or cylinders are for (air moves,
 //! lifted points, tool axes); callers add the tessellation's tolerance to their margins.
 
-use crate::geom::{Point3, Vector3};
+use crate::geom::{least, most, Point3, Vector3};
 use crate::model::Model;
 use std::sync::{Arc, Mutex};
 
@@ -380,27 +380,6 @@ impl From<&[Point3; 3]> for Tri {
     /// Rounds to single precision: exact for corners that came from single precision.
     fn from(t: &[Point3; 3]) -> Self {
         Tri(t.map(|q| [q.x as f32, q.y as f32, q.z as f32]))
-    }
-}
-
-/// The smaller of two numbers that are not NaN, by a plain comparison (`f64::min` is a call
-/// in wasm, for its NaN rule; the hierarchy's build and queries take millions).
-#[inline]
-fn least(a: f64, b: f64) -> f64 {
-    if b < a {
-        b
-    } else {
-        a
-    }
-}
-
-/// The larger of two numbers that are not NaN (see [`least`]).
-#[inline]
-fn most(a: f64, b: f64) -> f64 {
-    if b > a {
-        b
-    } else {
-        a
     }
 }
 

@@ -22,7 +22,7 @@
 //! taken from its corners with a [`INTERIOR_MARGIN`]: the bound holds up to terms of third
 //! order in the sample spacing.
 
-use crate::geom::Point3;
+use crate::geom::{least, most, Point3};
 
 /// Relative growth allowed for metric and second-derivative norms between a cell's corners
 /// and its interior (dimensionless).
@@ -102,10 +102,10 @@ pub fn second_derivative_bound(r: f64, kappa_convex: f64, w: f64, e: f64) -> f64
 /// second derivative along the surface and slope bound `l`.
 fn remainder(c: &[&Corner; 4], k: f64, l: f64) -> [f64; 2] {
     let m = 1.0 + INTERIOR_MARGIN;
-    let emax = c.iter().map(|c| c.metric[0]).fold(0.0, f64::max);
-    let gmax = c.iter().map(|c| c.metric[2]).fold(0.0, f64::max);
-    let fabs = c.iter().map(|c| c.metric[1].abs()).fold(0.0, f64::max);
-    let [suu, suv, svv] = [0, 1, 2].map(|i| c.iter().map(|c| c.second[i]).fold(0.0, f64::max));
+    let emax = c.iter().map(|c| c.metric[0]).fold(0.0, most);
+    let gmax = c.iter().map(|c| c.metric[2]).fold(0.0, most);
+    let fabs = c.iter().map(|c| c.metric[1].abs()).fold(0.0, most);
+    let [suu, suv, svv] = [0, 1, 2].map(|i| c.iter().map(|c| c.second[i]).fold(0.0, most));
     // 2|F δu δv| ≤ |F| (ρ δu² + δv²/ρ) for any ρ > 0; ρ = sqrt(E/G) adds at most |F|/sqrt(EG)
     // ≤ 1 of each diagonal term (the other way round a thin, stretched cell's short side
     // would take the long side's metric).
@@ -149,7 +149,7 @@ pub fn max_of_min_quadratics(
         let q = 0.5 * (h[0] * x[0] * x[0] + h[1] * x[1] * x[1]);
         q + (0..4)
             .map(|k| a[k][0] * x[0] + a[k][1] * x[1] + b[k])
-            .fold(f64::INFINITY, f64::min)
+            .fold(f64::INFINITY, least)
     };
     let mut best = (f64::NEG_INFINITY, [0.0; 2]);
     let mut consider = |x: [f64; 2]| {
@@ -227,7 +227,7 @@ fn max_of_min_parabolas(a: f64, b: f64, len: f64, h: f64) -> f64 {
 fn gouge_bound(c: &[&Corner; 4], frame: &CellFrame, r: f64, best: f64) -> f64 {
     let CellFrame { du, dv, boundary } = *frame;
     let depths = [0, 1, 2, 3].map(|i| c[i].overcut_mm);
-    let deepest = depths.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let deepest = depths.iter().copied().fold(f64::NEG_INFINITY, most);
     let bounded = GOUGE_BOUNDED_SHARE * r;
     // The distance to the deepest capsule's segment, `1/k` bounding its curvature, falls
     // from `r − D` at the bottom by at most the remainder over the cell: raise `k` until it
@@ -293,8 +293,8 @@ pub fn cell_bound(
     let diam = (c[0].point - c[3].point)
         .norm()
         .max((c[1].point - c[2].point).norm());
-    let kappa = c.iter().map(|c| c.kappa_convex).fold(0.0, f64::max);
-    let slope = c.iter().map(|c| c.slope).fold(0.0, f64::max);
+    let kappa = c.iter().map(|c| c.kappa_convex).fold(0.0, most);
+    let slope = c.iter().map(|c| c.slope).fold(0.0, most);
     let quarter = [0.25 * du * du, 0.25 * dv * dv];
 
     let gouge_upper_mm = gouge_bound(c, frame, r, best[1]);
@@ -312,13 +312,13 @@ pub fn cell_bound(
     let reach_first = c
         .iter()
         .map(|k| first_order(k))
-        .fold(f64::NEG_INFINITY, f64::max);
+        .fold(f64::NEG_INFINITY, most);
     let mut e_hi = reach_first;
     for _ in 0..MAX_ROUNDS {
         let w_min = c
             .iter()
             .map(|k| k.w_mm - (e_hi - k.left_mm))
-            .fold(f64::INFINITY, f64::min);
+            .fold(f64::INFINITY, least);
         if !(w_min > 0.0) || e_hi >= reach {
             break;
         }
