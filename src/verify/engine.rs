@@ -705,12 +705,22 @@ fn gouge_bottom(
 }
 
 /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other: the
-/// majority, over a coarse grid, of the side where the nearest ball centre lies.
+/// majority, over a coarse grid, of the side where the nearest ball centre lies. The count
+/// stops once the votes left cannot change the outcome.
 fn vote_side(ctx: &Ctx, probe: &mut Probe) -> f64 {
     let mut votes: i64 = 0;
+    let mut left = (ctx.surface.faces().len() * SIDE_PROBE * SIDE_PROBE) as i64;
     for face in ctx.surface.faces() {
         for i in 0..SIDE_PROBE {
             for j in 0..SIDE_PROBE {
+                // A tie goes to +1.
+                if votes - left >= 0 {
+                    return 1.0;
+                }
+                if votes + left < 0 {
+                    return -1.0;
+                }
+                left -= 1;
                 let (u, v) = (
                     (i as f64 + 0.5) / SIDE_PROBE as f64,
                     (j as f64 + 0.5) / SIDE_PROBE as f64,
