@@ -2,7 +2,7 @@
 //! the points within the tool radius of the segment its centre travels. For a ball-end tool
 //! this is the exact swept volume, so the intersection below is exact (closed form).
 
-use crate::geom::{Point3, Vector3};
+use crate::geom::{most, Point3, Vector3};
 
 /// The segment a ball centre travels along one move.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -156,9 +156,8 @@ impl Capsule {
                 None => (t_in, pin),
             }
         };
-        // A plain comparison: `f64::max` is a call in wasm (for its NaN rule), and this runs
-        // for every capsule a probe passes.
-        let t_out = if t_out < t_in { t_in } else { t_out };
+        // Not `f64::max`, a call in wasm: this runs for every capsule a probe passes.
+        let t_out = most(t_out, t_in);
         Span::within(t_in, t_out, pin, pout, lo, hi)
     }
 
