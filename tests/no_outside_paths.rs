@@ -33,11 +33,12 @@ fn tracked_files(root: &Path) -> Vec<PathBuf> {
             .map(|p| root.join(String::from_utf8_lossy(p).as_ref()))
             .collect();
     }
-    const SKIP: [&str; 6] = [
+    const SKIP: [&str; 7] = [
         ".git",
         "target",
         "node_modules",
         "pkg",
+        "pkg-view",
         "vendor",
         "test-artifacts",
     ];

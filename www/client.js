@@ -11,19 +11,26 @@ export class CancelledError extends Error {
   }
 }
 
-/** The engine's wasm, fetched and compiled (streamed, off the page's thread) once per page
- * while the first worker starts, and handed to every worker: a worker started again after a
- * Cancel neither fetches nor compiles it. Resolves to null where the browser cannot (the
- * worker then loads the wasm itself, and says what failed). */
-let compiled = null;
-function compiledEngine() {
-  if (!compiled) {
-    const url = new URL('./pkg/tspath_bg.wasm', import.meta.url);
-    compiled = typeof WebAssembly.compileStreaming === 'function'
+/** The engine's two wasm modules (see engine.js): the viewer, all the first draw needs, and
+ * the planner. */
+const VIEWER_URL = new URL('./pkg-view/tspath_bg.wasm', import.meta.url);
+const PLANNER_URL = new URL('./pkg/tspath_bg.wasm', import.meta.url);
+
+/** Requests only the planner answers: the client sends them once the worker has it. */
+const PLANNER_OPS = new Set(['plan', 'compare', 'pick', 'post', 'verify', 'csv']);
+
+/** Each module fetched and compiled (streamed, off the page's thread) once per page and
+ * handed to every worker: a worker started again after a Cancel neither fetches nor compiles
+ * it. Resolves to null where the browser cannot (the worker then loads the wasm itself, and
+ * says what failed). */
+const compiled = new Map();
+function compiledModule(url) {
+  if (!compiled.has(url.href)) {
+    compiled.set(url.href, typeof WebAssembly.compileStreaming === 'function'
       ? WebAssembly.compileStreaming(fetch(url)).catch(() => null)
-      : Promise.resolve(null);
+      : Promise.resolve(null));
   }
-  return compiled;
+  return compiled.get(url.href);
 }
 
 export class EngineClient {
@@ -33,6 +40,9 @@ export class EngineClient {
     this.pending = new Map(); // id -> {resolve, reject, onProgress}
     this.source = null; // what the current model was loaded from, to reload after a cancel
     this.info = null;
+    this.planner = null; // resolves once the worker runs the planner module
+    this.hasPlanner = false; // true from then on (until a cancel restarts the worker)
+    this.plannerCompiled = false; // true once the planner module is compiled here
     this.ready = this.#start();
   }
 
@@ -44,16 +54,48 @@ export class EngineClient {
       for (const p of this.pending.values()) p.reject(err);
       this.pending.clear();
     };
-    const started = compiledEngine().then((module) => this.#send('init', [module])).then((info) => {
-      this.info = info;
-      return info;
-    });
-    return this.source
+    // A worker started again after the planner was compiled starts on it.
+    const onPlanner = this.plannerCompiled;
+    this.hasPlanner = false;
+    const started = compiledModule(onPlanner ? PLANNER_URL : VIEWER_URL)
+      .then((module) => this.#send('init', [module, onPlanner]))
+      .then((info) => {
+        this.info = info;
+        return info;
+      });
+    const ready = this.source
       ? started.then(async (info) => {
         await this.#send('load', [this.source]);
         return info;
       })
       : started;
+    this.planner = onPlanner ? ready.then(() => { this.hasPlanner = true; }) : null;
+    if (this.planner) this.planner.catch(() => {});
+    return ready;
+  }
+
+  /** Resolves once the worker runs the planner module: fetched and compiled on the first
+   * call, then handed to the worker, which loads the current model into it. Call it when the
+   * model is shown, so planning does not wait for the download. */
+  loadPlanner() {
+    if (!this.planner) {
+      const worker = this.worker;
+      const planner = this.ready
+        .then(() => compiledModule(PLANNER_URL))
+        .then((module) => {
+          // A Cancel meanwhile started another worker, which has its own way to the planner.
+          if (this.worker !== worker) throw new CancelledError();
+          if (module) this.plannerCompiled = true;
+          return this.#send('upgrade', [module]);
+        })
+        .then(() => { this.hasPlanner = true; });
+      this.planner = planner;
+      // A failure (the download, say) is the caller's to show; the next call tries again.
+      planner.catch(() => {
+        if (this.planner === planner) this.planner = null;
+      });
+    }
+    return this.planner;
   }
 
   #onMessage(msg) {
@@ -78,7 +120,7 @@ export class EngineClient {
 
   /** Runs `op` on the engine once it is ready. */
   async call(op, args = [], onProgress = null) {
-    await this.ready;
+    await (PLANNER_OPS.has(op) ? this.loadPlanner() : this.ready);
     return this.#send(op, args, onProgress);
   }
 

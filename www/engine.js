@@ -1,20 +1,38 @@
-// The only importer of the generated wasm package. Everything else talks to the engine
-// through these functions (in practice only worker.js, which owns the engine), so the package
+// The only importer of the generated wasm packages. Everything else talks to the engine
+// through these functions (in practice only worker.js, which owns the engine), so the packages
 // can be rebuilt or moved without touching the page.
-import init, * as wasm from './pkg/tspath.js';
+//
+// The engine comes in two modules built from the same crate (scripts/build-wasm): the viewer
+// (www/pkg-view: load, place, tessellate, export; the machines and dialects by name), which is
+// all the first draw waits for, and the planner (www/pkg: the viewer's API and planning,
+// posting and the cutting simulation), fetched once a model is shown or planning is asked
+// for. Handles of one module cannot be passed to the other: a model is loaded again into the
+// planner (worker.js).
+import initViewer, * as viewer from './pkg-view/tspath.js';
 
-let ready = null;
+let viewerReady = null;
+let plannerReady = null;
 
-/** Loads and instantiates the wasm module once: from `module` (a compiled
- * WebAssembly.Module) when given, else fetched and compiled here. */
-export function loadEngine(module = null) {
-  if (!ready) ready = init(module ? { module_or_path: module } : undefined).then(() => wasm);
-  return ready;
+/** Instantiates the viewer module once: from `module` (a compiled WebAssembly.Module) when
+ * given, else fetched and compiled here. */
+export function loadViewer(module = null) {
+  if (!viewerReady) viewerReady = initViewer(module ? { module_or_path: module } : undefined).then(() => viewer);
+  return viewerReady;
 }
 
-/** What the engine offers: version, samples, machines (with their JSON), dialects. */
-export async function engineInfo() {
-  const w = await loadEngine();
+/** Instantiates the planner module once (its glue imported on first use), as loadViewer. */
+export function loadPlanner(module = null) {
+  if (!plannerReady) {
+    plannerReady = import('./pkg/tspath.js').then(async (planner) => {
+      await planner.default(module ? { module_or_path: module } : undefined);
+      return planner;
+    });
+  }
+  return plannerReady;
+}
+
+/** What engine `w` offers: version, samples, machines (with their JSON), dialects. */
+export function engineInfo(w) {
   return {
     version: w.version(),
     samples: w.sampleNames(),
@@ -26,16 +44,15 @@ export async function engineInfo() {
   };
 }
 
-/** A built-in sample model (a handle in wasm memory; call free() when done), placed by
- * `setup` if given (see Model.fromBytesPlaced). */
-export async function loadSample(name, setup = null) {
-  const w = await loadEngine();
-  return setup ? w.Model.samplePlaced(name, setup) : w.Model.sample(name);
-}
-
-/** A model from file bytes, placed by `setup` if given; throws an Error whose message says
- * what is wrong with the file. */
-export async function loadBytes(bytes, name, setup = null) {
-  const w = await loadEngine();
-  return setup ? w.Model.fromBytesPlaced(bytes, name, setup) : w.Model.fromBytes(bytes, name);
+/** A model of engine `w` (a handle in its wasm memory; call free() when done) from `source`:
+ * a built-in sample ({sample}) or file bytes ({bytes, name}), placed by `source.setup` if
+ * given (see Model.fromBytesPlaced); throws an Error whose message says what is wrong with the
+ * file. */
+export function loadModel(w, source) {
+  const { setup } = source;
+  if (source.sample !== undefined) {
+    return setup ? w.Model.samplePlaced(source.sample, setup) : w.Model.sample(source.sample);
+  }
+  const bytes = new Uint8Array(source.bytes);
+  return setup ? w.Model.fromBytesPlaced(bytes, source.name, setup) : w.Model.fromBytes(bytes, source.name);
 }

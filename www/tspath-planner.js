@@ -897,6 +897,8 @@ export class TspathPlanner extends HTMLElement {
       // From the navigation's start (the page's clock), what a visitor waits.
       this.dataset.firstDrawAtMs = String(Math.round(performance.now()));
     }
+    // The planner's module, fetched while the model is looked at (planning waits for it).
+    this.client.loadPlanner().catch(() => {});
     this.$('download-stl').disabled = false;
     this.$('save-job').disabled = false;
     this.state = 'model-loaded';
@@ -1282,7 +1284,8 @@ export class TspathPlanner extends HTMLElement {
     const bar = this.$('progress');
     bar.hidden = false;
     bar.value = 0;
-    this.#status('Planning… 0 %');
+    // (The planner's module may still be on its way: planning starts once it is in.)
+    this.#status(this.client.hasPlanner ? 'Planning… 0 %' : 'Loading the planner…');
     const t0 = performance.now();
     let result;
     try {

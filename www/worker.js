@@ -5,16 +5,29 @@
 // {id, ok: false, error}, and while planning posts {id, progress} (fraction done). Large
 // arrays travel as transferred typed arrays. A request cannot be interrupted once running:
 // the page cancels by terminating this worker and starting a new one (see client.js).
-import { engineInfo, loadBytes, loadEngine, loadSample } from './engine.js';
+// Requests are answered one at a time, in the order they came.
+//
+// The worker starts on the viewer module (or on the planner, when the page has it compiled
+// already) and is moved to the planner by `upgrade`, which loads the current model into it;
+// the page sends planning requests only after that (see engine.js).
+import { engineInfo, loadModel, loadPlanner, loadViewer } from './engine.js';
 
 const KIND_NAMES = ['feed', 'link', 'retract', 'rapid', 'plunge', 'approach'];
 /** Least progress interval posted to the page (ms): enough for a smooth bar. */
 const PROGRESS_INTERVAL_MS = 40;
 
+let engine = null; // the wasm module's exports in use: the viewer's or the planner's
+let planner = false; // whether `engine` is the planner
+let source = null; // what `model` was loaded from, to load it again into the planner
 let model = null; // wasm Model
 let mesh = null; // wasm SurfaceMesh of `model` (the drawn one; the heat map is per vertex of it)
 let plan = null; // wasm Plan of `model`
 let comparison = null; // wasm Comparison of `model` (its rows' plans not yet picked)
+
+/** Throws unless the planner module is the one in use (the page waits for `upgrade`). */
+function needPlanner() {
+  if (!planner) throw new Error('the planner module is not loaded yet');
+}
 
 function free(x) {
   if (x) x.free();
@@ -96,22 +109,47 @@ function planResult() {
 }
 
 const ops = {
-  /** Starts the engine from `module` (the page's compiled wasm; null: fetch it here). */
-  async init(module) {
-    await loadEngine(module);
-    return { result: await engineInfo() };
+  /** Starts the engine from `module` (the page's compiled wasm; null: fetch it here): the
+   * planner's when `isPlanner`, else the viewer's. */
+  async init(module, isPlanner) {
+    engine = isPlanner ? await loadPlanner(module) : await loadViewer(module);
+    planner = !!isPlanner;
+    return { result: engineInfo(engine) };
+  },
+
+  /** Moves to the planner module (`module` as for init): the current model is loaded into it
+   * again and drawn from there on (the same tessellation: the same code on the same input). */
+  async upgrade(module) {
+    if (planner) return { result: null };
+    const next = await loadPlanner(module);
+    let nextModel = null;
+    let nextMesh = null;
+    if (model) {
+      try {
+        nextModel = loadModel(next, source);
+        nextMesh = nextModel.tessellate(drawChordal(nextModel.summary()));
+      } catch (e) {
+        free(nextModel);
+        throw e;
+      }
+    }
+    mesh = free(mesh);
+    model = free(model);
+    engine = next;
+    planner = true;
+    model = nextModel;
+    mesh = nextMesh;
+    return { result: null };
   },
 
   /** Loads a sample ({sample}) or file bytes ({bytes, name}); the old model stays on failure. */
-  async load(source) {
-    const next = source.sample !== undefined
-      ? await loadSample(source.sample, source.setup)
-      : await loadBytes(new Uint8Array(source.bytes), source.name, source.setup);
+  async load(next) {
+    const nextModel = loadModel(engine, next);
     let nextMesh = null;
     try {
-      const summary = next.summary();
+      const summary = nextModel.summary();
       const chordal = drawChordal(summary);
-      nextMesh = next.tessellate(chordal);
+      nextMesh = nextModel.tessellate(chordal);
       const result = {
         summary,
         chordal_mm: chordal,
@@ -120,20 +158,21 @@ const ops = {
         normals: nextMesh.normals(),
         indices: nextMesh.indices(),
         patchIds: nextMesh.patchIds(),
-        eps: next.extraordinaryPoints(),
-        cage: next.controlEdges(),
+        eps: nextModel.extraordinaryPoints(),
+        cage: nextModel.controlEdges(),
       };
       plan = free(plan);
       comparison = free(comparison);
       mesh = free(mesh);
       model = free(model);
-      model = next;
+      model = nextModel;
       mesh = nextMesh;
+      source = next;
       const transfer = ['positions', 'normals', 'indices', 'patchIds', 'eps', 'cage'].map((k) => result[k].buffer);
       return { result, transfer };
     } catch (e) {
       free(nextMesh);
-      next.free();
+      nextModel.free();
       throw e;
     }
   },
@@ -144,6 +183,7 @@ const ops = {
    * plan. */
   async plan(options, post, id) {
     if (!model) throw new Error('no model is loaded');
+    needPlanner();
     plan = free(plan);
     plan = model.plan(options, progressTo(id));
     const answer = planResult();
@@ -166,6 +206,7 @@ const ops = {
    * each row's path for a small view. The rows' plans stay here for `pick`. */
   async compare(options, strategies, machine, simulate, id) {
     if (!model) throw new Error('no model is loaded');
+    needPlanner();
     comparison = free(comparison);
     comparison = model.compare(options, strategies, machine, simulate, progressTo(id));
     const report = comparison.report();
@@ -235,8 +276,8 @@ const ops = {
   },
 };
 
-self.onmessage = async (e) => {
-  const { id, op, args } = e.data;
+/** Answers one request. */
+async function answer({ id, op, args }) {
   try {
     if (!ops[op]) throw new Error(`unknown request ${op}`);
     const { result, transfer = [] } = await ops[op](...(args || []), id);
@@ -244,4 +285,11 @@ self.onmessage = async (e) => {
   } catch (err) {
     postMessage({ id, ok: false, error: err && err.message ? err.message : String(err) });
   }
+}
+
+// One at a time: `upgrade` waits for the planner's instantiation, and a request coming
+// meanwhile must find the engine it was sent for.
+let queue = Promise.resolve();
+self.onmessage = (e) => {
+  queue = queue.then(() => answer(e.data));
 };

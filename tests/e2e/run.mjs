@@ -7,8 +7,8 @@
 // Usage: node tests/e2e/run.mjs   (after scripts/build-wasm; builds the CLI with cargo)
 // TSPATH_CLI=path uses that CLI binary instead of building target/debug/tspath;
 // TSPATH_E2E_ONLY=substring runs the tests whose name contains it.
-// Prints, without asserting: the gzipped size of the wasm and the time to the first model
-// drawn.
+// Prints, without asserting: the gzipped size of the two wasm modules and the time to the
+// first model drawn.
 import { chromium } from 'playwright-core';
 import { execFile, execFileSync, spawnSync } from 'node:child_process';
 import { mkdir, mkdtemp, readFile, rm, writeFile } from 'node:fs/promises';
@@ -271,6 +271,17 @@ test('the page opens and draws the first model with WebGL', async (page, url) =>
   const fromNav = Number(await attr(page, 'data-first-draw-at-ms'));
   measured.firstDraw = { wall, inPage, fromNav };
   check(fromNav >= inPage && fromNav <= wall + 50, `first draw at ${fromNav} ms of the page's clock, ${inPage} ms after the element started, ${wall} ms from goto`);
+  // The first draw waits for the viewer's module only: the planner's is asked for once the
+  // model is shown.
+  const fetched = await page.evaluate(() => performance.getEntriesByType('resource')
+    .filter((e) => e.name.endsWith('_bg.wasm'))
+    .map((e) => ({ path: new URL(e.name).pathname, start: e.startTime })));
+  const viewer = fetched.find((e) => e.path.endsWith('/pkg-view/tspath_bg.wasm'));
+  check(!!viewer && viewer.start <= fromNav, `the viewer's wasm is fetched before the first draw: ${JSON.stringify(fetched)}`);
+  await page.waitForFunction((h) => document.querySelector(h).client.hasPlanner, HOST, { timeout: 20000 });
+  const planner = await page.evaluate(() => performance.getEntriesByType('resource')
+    .find((e) => new URL(e.name).pathname.endsWith('/pkg/tspath_bg.wasm'))?.startTime);
+  check(planner !== undefined && planner >= fromNav, `the planner's wasm is fetched after the first draw (at ${fromNav} ms): at ${planner} ms`);
   check(await attr(page, 'data-renderer') === 'webgl', 'headless Chromium (SwiftShader) should give the WebGL view');
   const gl = await page.evaluate(() => {
     const g = document.createElement('canvas').getContext('webgl2');
@@ -1933,8 +1944,12 @@ test('accessibility: axe-core finds no serious or critical violation on the main
 });
 
 // ------------------------------------------------------------------ run
-const wasmBytes = readFileSync(join(root, 'www', 'pkg', 'tspath_bg.wasm'));
-const wasmGz = gzipSync(wasmBytes, { level: 9 }).length;
+// The page's two modules (www/engine.js): the viewer, which the first draw waits for, and
+// the planner.
+const wasmSizes = [['viewer', 'pkg-view'], ['planner', 'pkg']].map(([part, dir]) => {
+  const bytes = readFileSync(join(root, 'www', dir, 'tspath_bg.wasm'));
+  return { part, bytes: bytes.length, gz: gzipSync(bytes, { level: 9 }).length };
+});
 
 const { server, url } = await startServer(0, '127.0.0.1');
 const FLAGS = [
@@ -1980,7 +1995,9 @@ try {
   server.close();
   await rm(work, { recursive: true, force: true });
 }
-console.log(`wasm: ${wasmBytes.length} bytes, ${wasmGz} gzipped (${(wasmGz / 1024).toFixed(1)} KB; target ≤ 400 KB)`);
+for (const w of wasmSizes) {
+  console.log(`wasm ${w.part}: ${w.bytes} bytes, ${w.gz} gzipped (${(w.gz / 1024).toFixed(1)} KB; target ≤ 400 KB)`);
+}
 if (measured.firstDraw) {
   const f = measured.firstDraw;
   console.log(`first model drawn: ${f.fromNav} ms from navigation, ${f.inPage} ms after the element started (target ≤ 1000 ms from navigation; tests/e2e/bench-first-draw.mjs times six runs)`);
