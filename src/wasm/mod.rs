@@ -16,6 +16,8 @@ use crate::surface::tessellate::Tessellation;
 use crate::verify;
 use wasm_bindgen::prelude::*;
 
+#[cfg(target_arch = "wasm32")]
+mod grow;
 #[cfg(feature = "planner")]
 pub mod planner;
 #[cfg(feature = "planner")]
