@@ -513,3 +513,26 @@ fn isfc_plans_one_pass_and_hands_over_its_cells_and_tree() {
     assert!(msg.contains("zigzag") && msg.contains("isfc"), "{msg}");
     assert_eq!(tspath::wasm::paper_lead_deg(), 10.0);
 }
+
+/// The allocator grows the memory in steps (`src/wasm/grow.rs`): small allocations that
+/// outgrow the memory make it grow by at least 1 MiB (16 pages) at once, where the standard
+/// allocator alone grows it by the one page they lack.
+#[wasm_bindgen_test]
+fn memory_grows_in_steps() {
+    use std::arch::wasm32::memory_size;
+    let mut kept: Vec<Vec<u8>> = Vec::new();
+    let mut steps = Vec::new();
+    // Three growths in a row, each seen right after the allocation that caused it.
+    while steps.len() < 3 {
+        let before = memory_size::<0>();
+        kept.push(vec![1; 1000]);
+        let after = memory_size::<0>();
+        if after != before {
+            steps.push(after - before);
+        }
+    }
+    assert!(
+        steps.iter().all(|&pages| pages >= 16),
+        "pages grown at once: {steps:?}"
+    );
+}
