@@ -536,3 +536,27 @@ fn memory_grows_in_steps() {
         "pages grown at once: {steps:?}"
     );
 }
+
+/// The quick summary is the summary without its smallest concave radius, which comes on
+/// its own: the same values as the whole summary's, for a concave and a convex model.
+#[wasm_bindgen_test]
+fn quick_summary_and_concave_radius_make_the_summary() {
+    let json = |v: &JsValue| String::from(js_sys::JSON::stringify(v).unwrap());
+    for name in ["keycap-concave", "head"] {
+        let model = Model::sample(name).unwrap();
+        let quick = model.quick_summary().unwrap();
+        let key = JsValue::from_str("smallest_concave_radius");
+        assert!(
+            !js_sys::Reflect::has(&quick, &key).unwrap(),
+            "{name}: not looked for"
+        );
+        let concave = model.smallest_concave_radius().unwrap();
+        let whole = model.summary().unwrap();
+        assert_eq!(
+            json(&concave),
+            json(&get(&whole, "smallest_concave_radius"))
+        );
+        js_sys::Reflect::set(&quick, &key, &concave).unwrap();
+        assert_eq!(json(&quick), json(&whole), "{name}");
+    }
+}

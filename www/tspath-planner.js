@@ -897,7 +897,9 @@ export class TspathPlanner extends HTMLElement {
       // From the navigation's start (the page's clock), what a visitor waits.
       this.dataset.firstDrawAtMs = String(Math.round(performance.now()));
     }
-    // The planner's module, fetched while the model is looked at (planning waits for it).
+    // The smallest concave radius, then the planner's module, while the model is looked at
+    // (planning waits for it).
+    this.#findConcave(this.model);
     this.client.loadPlanner().catch(() => {});
     this.$('download-stl').disabled = false;
     this.$('save-job').disabled = false;
@@ -933,7 +935,7 @@ export class TspathPlanner extends HTMLElement {
       ['T-junctions', int(s.t_junctions)],
       ['Holes', int(s.holes)],
       ...(s.subdivision_tags ? [['Subdivision tags', s.subdivision_tags]] : []),
-      ['Smallest concave radius', concave ? mmSig(concave.radius_mm) : 'none (nothing concave)', concave ? concave.radius_mm : ''],
+      ['Smallest concave radius', concave === undefined ? 'looking…' : concave ? mmSig(concave.radius_mm) : 'none (nothing concave)', concave ? concave.radius_mm : ''],
     ];
     this.#facts(this.$('summary'), rows.map(([k, v, raw]) => [k.toLowerCase().replace(/\W+/g, '-'), k, v, raw]));
     markTerms(this.$('summary'), 'dt');
@@ -984,12 +986,37 @@ export class TspathPlanner extends HTMLElement {
     }
   }
 
+  /** Looks for `model`'s smallest concave radius (it samples every face, so the model is
+   * drawn first): the summary's row and hint say "looking" until it comes; `data-concave`
+   * is `looking`, then `found`. */
+  async #findConcave(model) {
+    this.dataset.concave = 'looking';
+    let c;
+    try {
+      c = await this.client.call('concave');
+    } catch (e) {
+      // A Cancel meanwhile: the restarted worker has the model again; ask it.
+      if (e instanceof CancelledError && this.model === model) this.#findConcave(model);
+      else if (this.model === model) this.#status(`Could not find the smallest concave radius: ${e.message}`, true);
+      return;
+    }
+    if (this.model !== model) return;
+    model.summary.smallest_concave_radius = c;
+    this.#showSummary(model.summary, model.pub);
+    this.dataset.concave = 'found';
+  }
+
   /** Under the summary: what the smallest concave radius means for the ball chosen. */
   #concaveHint() {
     const el = this.$('concave-hint');
     const c = this.model?.summary.smallest_concave_radius;
     if (!this.model) {
       el.textContent = '';
+      return;
+    }
+    if (c === undefined) {
+      el.textContent = 'Looking for the smallest concave radius (the largest ball that reaches everywhere)…';
+      el.classList.remove('warn');
       return;
     }
     if (!c) {

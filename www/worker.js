@@ -127,7 +127,7 @@ const ops = {
     if (model) {
       try {
         nextModel = loadModel(next, source);
-        nextMesh = nextModel.tessellate(drawChordal(nextModel.summary()));
+        nextMesh = nextModel.tessellate(drawChordal(nextModel.quickSummary()));
       } catch (e) {
         free(nextModel);
         throw e;
@@ -147,7 +147,9 @@ const ops = {
     const nextModel = loadModel(engine, next);
     let nextMesh = null;
     try {
-      const summary = nextModel.summary();
+      // Without the smallest concave radius, which samples every face: the page asks for
+      // it (`concave`) once the model is drawn.
+      const summary = nextModel.quickSummary();
       const chordal = drawChordal(summary);
       nextMesh = nextModel.tessellate(chordal);
       const result = {
@@ -175,6 +177,12 @@ const ops = {
       nextModel.free();
       throw e;
     }
+  },
+
+  /** The current model's smallest concave radius: `{radius_mm, at_mm}` (mm) or null. */
+  async concave() {
+    if (!model) throw new Error('no model is loaded');
+    return { result: model.smallestConcaveRadius() };
   },
 
   /** Plans with `options` (PlanOptions fields), reporting progress under request `id`; with

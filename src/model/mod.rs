@@ -276,6 +276,16 @@ impl Model {
 
     /// Counts and bounding box.
     pub fn summary(&self) -> ModelSummary {
+        ModelSummary {
+            smallest_concave_radius: self.smallest_concave_radius(),
+            ..self.summary_without_concave()
+        }
+    }
+
+    /// [`Model::summary`] without looking for the smallest concave radius (`None` there):
+    /// quick, where that search samples every face (0.6 s in wasm for 10 000 faces), for a
+    /// page that shows the rest first.
+    pub fn summary_without_concave(&self) -> ModelSummary {
         let nv = self.mesh.vertex_count();
         ModelSummary {
             name: self.name.clone(),
@@ -296,7 +306,7 @@ impl Model {
             subdivision_tags: self.mesh.tags().describe(),
             patches: self.layout.len(),
             bbox_mm: self.surface.bbox(),
-            smallest_concave_radius: self.smallest_concave_radius(),
+            smallest_concave_radius: None,
         }
     }
 }

@@ -167,6 +167,24 @@ impl WasmModel {
         to_js(&self.model.summary())
     }
 
+    /// As `summary`, without `smallest_concave_radius` (the key is absent: not looked for),
+    /// whose search samples every face: what a page shows before the model is drawn.
+    #[wasm_bindgen(js_name = quickSummary)]
+    pub fn quick_summary(&self) -> Result<JsValue, JsError> {
+        let s = to_js(&self.model.summary_without_concave())?;
+        let key = JsValue::from_str("smallest_concave_radius");
+        js_sys::Reflect::delete_property(s.unchecked_ref::<js_sys::Object>(), &key)
+            .map_err(|_| JsError::new("could not shape the summary"))?;
+        Ok(s)
+    }
+
+    /// The summary's `smallest_concave_radius`: `{radius_mm, at_mm}` (mm) or `null` where
+    /// nothing is concave; found once, then remembered.
+    #[wasm_bindgen(js_name = smallestConcaveRadius)]
+    pub fn smallest_concave_radius(&self) -> Result<JsValue, JsError> {
+        to_js(&self.model.smallest_concave_radius())
+    }
+
     /// Positions of the extraordinary points on the surface, `x y z` each (mm).
     #[wasm_bindgen(js_name = extraordinaryPoints)]
     pub fn extraordinary_points(&self) -> js_sys::Float64Array {

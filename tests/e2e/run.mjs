@@ -922,7 +922,7 @@ test('the public .tsm files are in the picker and their summaries show every val
     await page.waitForFunction(([h, file]) => {
       const el = document.querySelector(h);
       const src = el.shadowRoot.getElementById('summary-source');
-      return el.dataset.state === 'model-loaded' && src && src.textContent.includes(file);
+      return el.dataset.state === 'model-loaded' && el.dataset.concave === 'found' && src && src.textContent.includes(file);
     }, [HOST, f], { timeout: 30000 });
     const fit = await page.evaluate(() => {
       const r = document.querySelector('tspath-planner').shadowRoot;
@@ -1556,13 +1556,14 @@ test('a file model survives a reload; a link to a file this browser does not kee
   await waitState(page, 'model-loaded');
   const obj = extrudedObj();
   await page.setInputFiles('#file', { name: 'wave-sheet.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
-  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded', HOST);
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded' && document.querySelector(h).dataset.concave === 'found', HOST);
+  // (The whole summary: the smallest concave radius comes just after the model is drawn.)
   const before = await host(page, (el) => el.model.summary);
   check(new URL(page.url()).searchParams.get('model') === 'file:wave-sheet.obj', `the URL names the file: ${page.url()}`);
   // Kept in the browser (stored after the model is shown), then reloaded.
   await page.waitForSelector(`${HOST}[data-kept="wave-sheet.obj"]`, { state: 'attached' });
   await page.reload();
-  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded', HOST, { timeout: 30000 });
+  await page.waitForFunction((h) => document.querySelector(h).model?.summary?.name === 'wave-sheet' && document.querySelector(h).dataset.state === 'model-loaded' && document.querySelector(h).dataset.concave === 'found', HOST, { timeout: 30000 });
   const after = await host(page, (el) => el.model.summary);
   check(JSON.stringify(after) === JSON.stringify(before), 'the same model after the reload');
   // Another browser profile has no such file: it says so and opens the first sample.
