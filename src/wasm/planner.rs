@@ -1,5 +1,5 @@
-//! The planner's half of the JavaScript API: machines and dialects, planning, comparing,
-//! posting and the cutting simulation. Built with the `planner` feature (on by default); the
+//! The planner's half of the JavaScript API: planning, comparing, posting and the cutting
+//! simulation. Built with the `planner` feature (on by default); the
 //! page's first module is built without it, so the model is drawn before this code arrives.
 
 use super::{js_err, to_js, WasmMesh, WasmModel};
