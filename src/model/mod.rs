@@ -60,6 +60,11 @@ const SIDE_SAMPLES: usize = 4;
 /// Samples per face side for the smallest concave radius, evenly, plus the same again
 /// crowded towards the sides (curvature peaks at folded corners within 1% of a face).
 const CONCAVE_SAMPLES: usize = 9;
+/// Distances from the sides of the crowded samples (of a face side's length): written out,
+/// as `0.1f64.powi(k)` rounds differently where the compiler folds it (release builds) and
+/// where it is computed (debug builds), and the smallest radius found moved with it.
+const CONCAVE_CROWDED: [f64; CONCAVE_SAMPLES - 1] =
+    [1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
 
 /// Counts and size of a model, as shown by `tspath info` and the page.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -210,10 +215,7 @@ impl Model {
         *self.concave.get_or_init(|| {
             let n = CONCAVE_SAMPLES;
             let even = (0..n).map(|k| k as f64 / (n - 1) as f64);
-            let crowded = (1..n).flat_map(|k| {
-                let e = 0.1f64.powi(k as i32);
-                [e, 1.0 - e]
-            });
+            let crowded = CONCAVE_CROWDED.iter().flat_map(|&e| [e, 1.0 - e]);
             let ts: Vec<f64> = even.chain(crowded).collect();
             let mut best: Option<ConcaveSpot> = None;
             let flip = self.tool_side() < 0.0;
