@@ -498,7 +498,7 @@ fn isfc_plans_one_pass_and_hands_over_its_cells_and_tree() {
         .plan(js_options(&[("scallop_mm", 0.05.into())]), None)
         .unwrap();
     assert!(get(&zig.report().unwrap(), "cells").is_undefined());
-    let msg = js_message(zig.isfc_cells().err().expect("isoparametric has no cells"));
+    let msg = js_message(zig.isfc_cells().expect_err("isoparametric has no cells"));
     assert!(
         msg.contains("isoparametric") && msg.contains("isfc"),
         "{msg}"
