@@ -17,7 +17,7 @@ const VIEWER_URL = new URL('./pkg-view/tspath_bg.wasm', import.meta.url);
 const PLANNER_URL = new URL('./pkg/tspath_bg.wasm', import.meta.url);
 
 /** Requests only the planner answers: the client sends them once the worker has it. */
-const PLANNER_OPS = new Set(['plan', 'compare', 'pick', 'post', 'verify', 'csv']);
+const PLANNER_OPS = new Set(['concave', 'plan', 'compare', 'pick', 'post', 'verify', 'csv']);
 
 /** Each module fetched and compiled (streamed, off the page's thread) once per page and
  * handed to every worker: a worker started again after a Cancel neither fetches nor compiles

@@ -897,10 +897,9 @@ export class TspathPlanner extends HTMLElement {
       // From the navigation's start (the page's clock), what a visitor waits.
       this.dataset.firstDrawAtMs = String(Math.round(performance.now()));
     }
-    // The smallest concave radius, then the planner's module, while the model is looked at
-    // (planning waits for it).
+    // The planner's module while the model is looked at (planning waits for it), and the
+    // smallest concave radius from it.
     this.#findConcave(this.model);
-    this.client.loadPlanner().catch(() => {});
     this.$('download-stl').disabled = false;
     this.$('save-job').disabled = false;
     this.state = 'model-loaded';
@@ -987,8 +986,9 @@ export class TspathPlanner extends HTMLElement {
   }
 
   /** Looks for `model`'s smallest concave radius (it samples every face, so the model is
-   * drawn first): the summary's row and hint say "looking" until it comes; `data-concave`
-   * is `looking`, then `found`. */
+   * drawn first; asked of the planner's module, which loads the model then and keeps the
+   * radius for planning): the summary's row and hint say "looking" until it comes;
+   * `data-concave` is `looking`, then `found`. */
   async #findConcave(model) {
     this.dataset.concave = 'looking';
     let c;

@@ -19,6 +19,7 @@ const PROGRESS_INTERVAL_MS = 40;
 let engine = null; // the wasm module's exports in use: the viewer's or the planner's
 let planner = false; // whether `engine` is the planner
 let source = null; // what `model` was loaded from, to load it again into the planner
+let chordal = 0; // the tolerance `mesh` was tessellated with (mm), the same in the planner
 let model = null; // wasm Model
 let mesh = null; // wasm SurfaceMesh of `model` (the drawn one; the heat map is per vertex of it)
 let plan = null; // wasm Plan of `model`
@@ -127,7 +128,7 @@ const ops = {
     if (model) {
       try {
         nextModel = loadModel(next, source);
-        nextMesh = nextModel.tessellate(drawChordal(nextModel.quickSummary()));
+        nextMesh = nextModel.tessellate(chordal);
       } catch (e) {
         free(nextModel);
         throw e;
@@ -150,11 +151,11 @@ const ops = {
       // Without the smallest concave radius, which samples every face: the page asks for
       // it (`concave`) once the model is drawn.
       const summary = nextModel.quickSummary();
-      const chordal = drawChordal(summary);
-      nextMesh = nextModel.tessellate(chordal);
+      const tolerance = drawChordal(summary);
+      nextMesh = nextModel.tessellate(tolerance);
       const result = {
         summary,
-        chordal_mm: chordal,
+        chordal_mm: tolerance,
         area_mm2: meshArea(nextMesh.positions(), nextMesh.indices()),
         positions: nextMesh.positions(),
         normals: nextMesh.normals(),
@@ -170,6 +171,7 @@ const ops = {
       model = nextModel;
       mesh = nextMesh;
       source = next;
+      chordal = tolerance;
       const transfer = ['positions', 'normals', 'indices', 'patchIds', 'eps', 'cage'].map((k) => result[k].buffer);
       return { result, transfer };
     } catch (e) {
@@ -179,9 +181,12 @@ const ops = {
     }
   },
 
-  /** The current model's smallest concave radius: `{radius_mm, at_mm}` (mm) or null. */
+  /** The current model's smallest concave radius: `{radius_mm, at_mm}` (mm) or null. Asked
+   * of the planner, whose model keeps it for planning (found in the viewer, it was looked for
+   * again by the first plan). */
   async concave() {
     if (!model) throw new Error('no model is loaded');
+    needPlanner();
     return { result: model.smallestConcaveRadius() };
   },
 

@@ -636,6 +636,8 @@ test('planned with problems: keycap-concave with a 1.5 mm ball warns, lists the 
 test('a malformed file shows an error and the previous model stays usable', async (page, url) => {
   await page.goto(`${url}?model=keycap-convex`);
   await waitState(page, 'model-loaded');
+  // (The whole summary: the smallest concave radius comes after the model is drawn.)
+  await page.waitForSelector(`${HOST}[data-concave="found"]`, { state: 'attached' });
   const summaryBefore = await page.textContent('#summary');
   await page.setInputFiles('#file', {
     name: 'broken.json',
