@@ -35,6 +35,17 @@ function free(x) {
   return null;
 }
 
+/** Makes `nextModel` and its drawn `nextMesh` the current ones; the old model, mesh, plan and
+ * comparison are freed. */
+function adopt(nextModel, nextMesh) {
+  plan = free(plan);
+  comparison = free(comparison);
+  mesh = free(mesh);
+  model = free(model);
+  model = nextModel;
+  mesh = nextMesh;
+}
+
 /** Area of a triangle mesh (mm²): the drawn surface, within its chordal tolerance. */
 function meshArea(p, idx) {
   let area = 0;
@@ -134,12 +145,9 @@ const ops = {
         throw e;
       }
     }
-    mesh = free(mesh);
-    model = free(model);
+    adopt(nextModel, nextMesh);
     engine = next;
     planner = true;
-    model = nextModel;
-    mesh = nextMesh;
     return { result: null };
   },
 
@@ -164,12 +172,7 @@ const ops = {
         eps: nextModel.extraordinaryPoints(),
         cage: nextModel.controlEdges(),
       };
-      plan = free(plan);
-      comparison = free(comparison);
-      mesh = free(mesh);
-      model = free(model);
-      model = nextModel;
-      mesh = nextMesh;
+      adopt(nextModel, nextMesh);
       source = next;
       chordal = tolerance;
       const transfer = ['positions', 'normals', 'indices', 'patchIds', 'eps', 'cage'].map((k) => result[k].buffer);
