@@ -739,6 +739,8 @@ fn snap_to(v: f64, lo: f64, hi: f64, tol: f64) -> f64 {
 /// Relative mismatch between a chart rectangle's area and the face parts inside it above
 /// which faces do not fill it.
 const RECT_FILL_REL: f64 = 1e-9;
+/// Patch parameters closer than this are one point (dimensionless, a share of the patch).
+const SAME_POINT_PARAM: f64 = 1e-9;
 
 /// The chart rectangle `(min, max)` of a local rectangle under a placement.
 fn chart_rect(r: &[f64; 4], (k, off): Placement) -> ([f64; 2], [f64; 2]) {
@@ -1032,6 +1034,40 @@ impl Patch {
         let x = local[0].clamp(p.local[0], p.local[1]);
         let y = local[1].clamp(p.local[2], p.local[3]);
         (k, [x, y])
+    }
+
+    /// Patch parameters `(u, v)` of the extraordinary points on the patch (inside it or on
+    /// its sides and corners), each once.
+    pub fn singular_points(&self, surface: &Surface) -> Vec<[f64; 2]> {
+        let mut out: Vec<[f64; 2]> = Vec::new();
+        for p in &self.pieces {
+            let face = &surface.faces()[p.face as usize];
+            for c in face.singular_corners() {
+                let local = [c[0] * face.width, c[1] * face.height];
+                let inside = local[0] >= p.local[0]
+                    && local[0] <= p.local[1]
+                    && local[1] >= p.local[2]
+                    && local[1] <= p.local[3];
+                if !inside {
+                    continue;
+                }
+                let r = rot(p.quarter_turns, local);
+                let uv = [
+                    (r[0] + p.offset[0]) / self.width,
+                    (r[1] + p.offset[1]) / self.height,
+                ];
+                // Pieces meeting at the point give it each (knot coordinates are exact
+                // sums of knot intervals, so the copies agree to rounding).
+                let same = |q: &[f64; 2]| {
+                    (q[0] - uv[0]).abs() <= SAME_POINT_PARAM
+                        && (q[1] - uv[1]).abs() <= SAME_POINT_PARAM
+                };
+                if !out.iter().any(same) {
+                    out.push(uv);
+                }
+            }
+        }
+        out
     }
 
     /// The iso-line `v = at` (`along_u`) or `u = at` of the patch, for many evaluations along

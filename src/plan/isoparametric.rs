@@ -62,6 +62,10 @@ pub trait ParamSurface {
     /// The iso-line along `dir` at across-parameter `w` (`at(dir, t, w)` for running `t`),
     /// for many evaluations along it.
     fn line(&self, dir: FeedDir, w: f64) -> Box<dyn ParamLine + '_>;
+    /// Parameters `(u, v)` of the surface's singular points (extraordinary points) on it.
+    fn singular_points(&self) -> Vec<[f64; 2]> {
+        Vec::new()
+    }
     /// +1 if the tool works from the side `S_u × S_v` points to, −1 if from the other.
     fn side(&self) -> f64 {
         1.0
@@ -117,6 +121,9 @@ impl ParamSurface for PatchView<'_> {
             line: self.patch.line(self.surface, dir == FeedDir::AlongU, w),
             side: self.side,
         })
+    }
+    fn singular_points(&self) -> Vec<[f64; 2]> {
+        self.patch.singular_points(self.surface)
     }
 }
 
@@ -175,12 +182,38 @@ fn at(dir: FeedDir, t: f64, w: f64) -> (f64, f64) {
     }
 }
 
+/// Where a pass is sampled for its side step, for a patch with singular points at
+/// `singular` along the passes (the running parameter `t` of each): [`pass_samples`], and
+/// for a singular point inside the pass [`END_SAMPLES`] on both sides of it. Where a pass
+/// runs past an extraordinary point (a rectangle's side through a hole's corner), the
+/// parameterisation stretches within a fraction of the even samples' spacing: on bumps-hole
+/// cut in rectangles whose sides run through the hole's corners, the even samples missed it
+/// and the cut left 0.085 mm where 0.05 mm was asked.
+fn step_samples(singular: &[f64]) -> Vec<f64> {
+    let near_end = END_SAMPLES.iter().copied().fold(0.0, f64::max);
+    let mut ts: Vec<f64> = pass_samples().collect();
+    for &t in singular {
+        if t > near_end && t < 1.0 - near_end {
+            ts.extend(END_SAMPLES.iter().flat_map(|&e| [t - e, t + e]));
+        }
+    }
+    ts
+}
+
 /// Parametric side step from the pass at `w` for scallop `h`: the smallest over the pass
-/// (concave curvature tighter than the ball clamped, see [`stepover::side_step_clamped`]).
-fn required_step(s: &dyn ParamSurface, dir: FeedDir, w: f64, h: f64, r: f64) -> f64 {
+/// at `samples` (concave curvature tighter than the ball clamped, see
+/// [`stepover::side_step_clamped`]).
+fn required_step(
+    s: &dyn ParamSurface,
+    dir: FeedDir,
+    w: f64,
+    h: f64,
+    r: f64,
+    samples: &[f64],
+) -> f64 {
     let mut best = f64::INFINITY;
     let mut line = s.line(dir, w);
-    for t in pass_samples() {
+    for &t in samples {
         let Some(dg) = geom_of(s, &line.derivs(t)) else {
             continue;
         };
@@ -216,7 +249,19 @@ pub struct StepProfile {
 impl StepProfile {
     /// Samples the required step across the patch.
     pub fn new(s: &dyn ParamSurface, dir: FeedDir, h0: f64, r: f64) -> Result<Self> {
-        let need = |w: f64| required_step(s, dir, w, h0, r);
+        // The running parameter of each singular point along the passes.
+        let mut singular: Vec<f64> = s
+            .singular_points()
+            .iter()
+            .map(|p| match dir {
+                FeedDir::AlongU => p[0],
+                FeedDir::AlongV => p[1],
+            })
+            .collect();
+        crate::sort::sort_floats(&mut singular);
+        singular.dedup();
+        let samples = step_samples(&singular);
+        let need = |w: f64| required_step(s, dir, w, h0, r, &samples);
         let mut points = vec![(0.0, need(0.0))];
         for i in 1..=PROFILE_INTERVALS {
             let w = i as f64 / PROFILE_INTERVALS as f64;

@@ -241,6 +241,15 @@ impl FaceLine<'_> {
 }
 
 impl FaceSurface {
+    /// The corners of `[0,1]²` at extraordinary points (where the parameterisation is
+    /// singular): those where the face's subdivision tree ends in a cap.
+    pub fn singular_corners(&self) -> Vec<[f64; 2]> {
+        match &self.form {
+            FaceForm::Tree(node) => node.cap_corners(),
+            FaceForm::Grid { .. } => Vec::new(),
+        }
+    }
+
     /// Point and derivatives at `(u, v)` in `[0,1]²`.
     pub fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
         let (ub, vb) = self.breaks();

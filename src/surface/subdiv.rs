@@ -109,6 +109,33 @@ pub(crate) enum Found<'a> {
 }
 
 impl Node {
+    /// The corners of the node's square `[0,1]²` where it holds a cap (an extraordinary
+    /// point's limit), in the order the tree holds them.
+    pub fn cap_corners(&self) -> Vec<[f64; 2]> {
+        fn walk(node: &Node, origin: [f64; 2], size: f64, out: &mut Vec<[f64; 2]>) {
+            match node {
+                Node::Leaf { .. } => {}
+                // A cap is the tiny square at a corner of the face: the corner nearest it.
+                Node::Cap(_) => {
+                    out.push([origin[0] + 0.5 * size, origin[1] + 0.5 * size].map(|x| x.round()))
+                }
+                Node::Split(ch) => {
+                    let h = 0.5 * size;
+                    for (k, c) in ch.iter().enumerate() {
+                        let o = [
+                            origin[0] + h * (k % 2) as f64,
+                            origin[1] + h * (k / 2) as f64,
+                        ];
+                        walk(c, o, h, out);
+                    }
+                }
+            }
+        }
+        let mut out = Vec::new();
+        walk(self, [0.0, 0.0], 1.0, &mut out);
+        out
+    }
+
     /// The leaf or cap holding `(u, v)` (in the node's square `[0,1]²`).
     pub(crate) fn descend(&self, mut u: f64, mut v: f64) -> Found<'_> {
         let mut node = self;
