@@ -14,7 +14,7 @@ use crate::plan::corners::Crossfeed;
 use crate::plan::draft::Footprint;
 use crate::plan::isoparametric;
 use crate::plan::pipeline::{self, Planned};
-use crate::plan::PlanOptions;
+use crate::plan::{stepover, PlanOptions};
 use serde::{Deserialize, Serialize};
 
 /// A feature region as the report gives it.
@@ -44,6 +44,10 @@ const DRAFT_SHARE: f64 = 0.7;
 /// A feature box holding less than this share of its region's largest box (area on the
 /// surface) is cut with the rest of the domain.
 pub const SMALL_BOX_SHARE: f64 = 0.05;
+/// A strip between a feature box and the domain's edge, a hole or another box's side
+/// narrower than this many flat side steps (`sqrt(8 r h)`) is given to the box: as a
+/// rectangle of its own it would take at least two passes of the box's length.
+pub const STRIP_SIDE_STEPS: f64 = 4.0;
 /// Samples per side of a rectangle for its area.
 const AREA_SAMPLES: usize = 16;
 
@@ -84,6 +88,34 @@ pub fn plan(
             .collect::<Vec<bool>>()
             .into_iter();
         boxes.retain(|_| !small.next().unwrap_or(false));
+        // Strips narrower than STRIP_SIDE_STEPS flat side steps between a box and the
+        // domain's edge, a hole or another box's side go to the box.
+        let step = stepover::side_step_clamped(opts.scallop_mm, opts.tool_radius_mm, 0.0);
+        let reach: Vec<[f64; 2]> = boxes
+            .iter()
+            .map(|(_, g, c)| {
+                let mm = found.box_sides_mm(&model.surface, g);
+                [0, 1].map(|a| {
+                    let knots = c[2 * a + 1] - c[2 * a];
+                    // Knot units per mm along the side, times the strip's width in mm.
+                    if mm[a] > 0.0 {
+                        STRIP_SIDE_STEPS * step * knots / mm[a]
+                    } else {
+                        0.0
+                    }
+                })
+            })
+            .collect();
+        let mut charts: Vec<(u32, [f64; 4])> = boxes.iter().map(|&(l, _, c)| (l, c)).collect();
+        rects::grow_over_strips(
+            &found.map.chart.face_rects,
+            &mut charts,
+            &reach,
+            found.map.chart.line_tol(),
+        );
+        for (b, (_, c)) in boxes.iter_mut().zip(charts) {
+            b.2 = c;
+        }
         let rects = found.rectangles(&boxes);
         let regions: Vec<RegionReport> = found
             .features

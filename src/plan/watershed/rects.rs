@@ -3,9 +3,12 @@
 //!
 //! Every face side and box side is extended into a line across the domain's chart; the
 //! cells between the lines are classed by the box holding them (or none), and cells of one
-//! class are merged greedily — from the lowest row up, leftmost first, as wide as the class
-//! runs, then as high as the whole width stays in the class — so that a box inside the
-//! domain comes out whole. Cells outside every face (holes, notches) are left out.
+//! class are merged largest first — of all rectangles of one class's free cells, the one
+//! with the most chart area, again and again — so that a box inside the domain comes out
+//! whole and the rest comes in few, broad rectangles (each rectangle costs the passes at
+//! its sides, and the greedy row-by-row merge this replaced left a one-cell column between
+//! two boxes running up through the strip above them). Cells outside every face (holes,
+//! notches) are left out.
 
 /// A rectangle of the domain's chart and the feature region it belongs to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,35 +57,245 @@ pub fn rectangles(faces: &[[f64; 4]], boxes: &[(u32, [f64; 4])], tol: f64) -> Ve
             }
         }
     }
+    // Largest first: of the rectangles of one class not yet taken, the one with the most
+    // chart area (the lowest, then leftmost, of equal ones), until every cell is taken.
+    let width = |i: usize| lines[0][i + 1] - lines[0][i];
     let mut taken = vec![false; ns * nt];
     let mut out = Vec::new();
-    for j in 0..nt {
-        for i in 0..ns {
-            let Some(c) = class[j * ns + i] else { continue };
-            if taken[j * ns + i] {
-                continue;
-            }
-            let free = |a: usize, b: usize, taken: &[bool]| {
-                class[b * ns + a] == Some(c) && !taken[b * ns + a]
-            };
-            let mut i1 = i;
-            while i1 + 1 < ns && free(i1 + 1, j, &taken) {
-                i1 += 1;
-            }
-            let mut j1 = j;
-            while j1 + 1 < nt && (i..=i1).all(|a| free(a, j1 + 1, &taken)) {
-                j1 += 1;
-            }
-            for b in j..=j1 {
-                for a in i..=i1 {
-                    taken[b * ns + a] = true;
+    loop {
+        // Free cells of one class straight above each cell, itself included.
+        let mut up = vec![0usize; ns * nt];
+        for j in (0..nt).rev() {
+            for i in 0..ns {
+                let c = j * ns + i;
+                if class[c].is_some() && !taken[c] {
+                    let above = j + 1 < nt && class[c + ns] == class[c] && !taken[c + ns];
+                    up[c] = 1 + if above { up[c + ns] } else { 0 };
                 }
             }
-            out.push(ChartRect {
-                chart: [lines[0][i], lines[0][i1 + 1], lines[1][j], lines[1][j1 + 1]],
-                feature: (c != 0).then_some(c),
-            });
         }
+        // (area, i0, i1, j0, j1) of the best so far.
+        let mut best: Option<(f64, usize, usize, usize, usize)> = None;
+        for j in 0..nt {
+            for i in 0..ns {
+                let c = j * ns + i;
+                if up[c] == 0 {
+                    continue;
+                }
+                let (mut rows, mut w) = (usize::MAX, 0.0);
+                for i1 in i..ns {
+                    let c1 = j * ns + i1;
+                    if up[c1] == 0 || class[c1] != class[c] {
+                        break;
+                    }
+                    rows = rows.min(up[c1]);
+                    w += width(i1);
+                    let h = lines[1][j + rows] - lines[1][j];
+                    if best.is_none_or(|b| w * h > b.0) {
+                        best = Some((w * h, i, i1, j, j + rows - 1));
+                    }
+                }
+            }
+        }
+        let Some((_, i0, i1, j0, j1)) = best else {
+            break;
+        };
+        for b in j0..=j1 {
+            for a in i0..=i1 {
+                taken[b * ns + a] = true;
+            }
+        }
+        let c = class[j0 * ns + i0].unwrap_or(0);
+        out.push(ChartRect {
+            chart: [
+                lines[0][i0],
+                lines[0][i1 + 1],
+                lines[1][j0],
+                lines[1][j1 + 1],
+            ],
+            feature: (c != 0).then_some(c),
+        });
     }
     out
+}
+
+/// Grows feature boxes over the thin strips their sides leave: each side (in the order
+/// left, right, bottom, top; boxes in order) moves outward to the nearest line that ends
+/// a strip — the domain's edge, a hole's edge or another box's parallel side — when that
+/// line lies within `reach[k]` (knot units: `[along s, along t]` for box `k`) and the strip
+/// it sweeps is inside the domain and outside every other box. Such a strip would
+/// otherwise be a rectangle of its own, narrower than a few side steps yet as long as the
+/// box, cut in passes of its full length (or, against another box's side, a step in the
+/// rectangles round it). `tol` is the distance (knot units) within which two lines are one.
+pub fn grow_over_strips(
+    faces: &[[f64; 4]],
+    boxes: &mut [(u32, [f64; 4])],
+    reach: &[[f64; 2]],
+    tol: f64,
+) {
+    let area = |r: &[f64; 4]| (r[1] - r[0]).max(0.0) * (r[3] - r[2]).max(0.0);
+    let meet = |a: &[f64; 4], b: &[f64; 4]| {
+        [
+            a[0].max(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].min(b[3]),
+        ]
+    };
+    let lo = [0, 2].map(|k| faces.iter().map(|f| f[k]).fold(f64::INFINITY, f64::min));
+    let hi = [1, 3].map(|k| faces.iter().map(|f| f[k]).fold(f64::NEG_INFINITY, f64::max));
+    for k in 0..boxes.len() {
+        // Sides: index into the box (0 s0, 1 s1, 2 t0, 3 t1); the axis; the outward sign.
+        for side in 0..4 {
+            let axis = side / 2;
+            let out = if side % 2 == 0 { -1.0 } else { 1.0 };
+            let b = boxes[k].1;
+            let at = b[side];
+            let limit = reach[k][axis];
+            // The box's extent across the side.
+            let (c0, c1) = if axis == 0 {
+                (b[2], b[3])
+            } else {
+                (b[0], b[1])
+            };
+            // Whether the domain ends at line `x` somewhere along the box: the faces that
+            // start at `x` on the far side do not cover the box's extent.
+            let ends_at = |x: f64| {
+                let far = if out > 0.0 { 2 * axis } else { 2 * axis + 1 };
+                let covered: f64 = faces
+                    .iter()
+                    .filter(|f| (f[far] - x).abs() <= tol)
+                    .map(|f| {
+                        let (f0, f1) = if axis == 0 {
+                            (f[2], f[3])
+                        } else {
+                            (f[0], f[1])
+                        };
+                        (f1.min(c1) - f0.max(c0)).max(0.0)
+                    })
+                    .sum();
+                covered < (c1 - c0) - tol
+            };
+            // Lines beyond the side within reach: the domain's bound, face sides where the
+            // domain ends beyond them, and other boxes' sides along the same axis.
+            let mut lines: Vec<f64> = vec![if out > 0.0 { hi[axis] } else { lo[axis] }];
+            for f in faces {
+                let x = f[2 * axis + usize::from(out > 0.0)];
+                if out * (x - at) > tol && out * (x - at) <= limit && ends_at(x) {
+                    lines.push(x);
+                }
+            }
+            for (j, o) in boxes.iter().enumerate() {
+                if j != k {
+                    lines.extend([o.1[2 * axis], o.1[2 * axis + 1]]);
+                }
+            }
+            let Some(to) = lines
+                .into_iter()
+                .filter(|&x| out * (x - at) > tol && out * (x - at) <= limit)
+                .min_by(|a, b| (out * (a - at)).total_cmp(&(out * (b - at))))
+            else {
+                continue;
+            };
+            let mut strip = b;
+            strip[side ^ 1] = at;
+            strip[side] = to;
+            // An area thinner than `tol` across the strip counts as none.
+            let slack = tol * ((strip[1] - strip[0]) + (strip[3] - strip[2]));
+            let inside: f64 = faces.iter().map(|f| area(&meet(f, &strip))).sum();
+            let taken = boxes
+                .iter()
+                .enumerate()
+                .any(|(j, o)| j != k && area(&meet(&o.1, &strip)) > slack);
+            if !taken && area(&strip) - inside <= slack {
+                boxes[k].1[side] = to;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A plate of `ns × nt` unit faces.
+    fn plate(ns: usize, nt: usize) -> Vec<[f64; 4]> {
+        (0..nt)
+            .flat_map(|j| {
+                (0..ns).map(move |i| [i as f64, i as f64 + 1.0, j as f64, j as f64 + 1.0])
+            })
+            .collect()
+    }
+
+    fn charts(rects: &[ChartRect]) -> Vec<([f64; 4], Option<u32>)> {
+        rects.iter().map(|r| (r.chart, r.feature)).collect()
+    }
+
+    /// Two boxes side by side in an 11 × 8 plate: the strips below and above them run the
+    /// whole width, and the rest is three rectangles (seven in all). The row-by-row merge
+    /// gave eight: the column between the boxes ran up through the strip above them.
+    #[test]
+    fn the_rest_comes_in_few_broad_rectangles() {
+        let boxes = [(1, [0.0, 5.0, 2.0, 6.0]), (2, [7.0, 10.0, 3.0, 6.0])];
+        let r = rectangles(&plate(11, 8), &boxes, 1e-9);
+        assert_eq!(
+            charts(&r),
+            vec![
+                ([0.0, 11.0, 0.0, 2.0], None),
+                ([0.0, 11.0, 6.0, 8.0], None),
+                ([0.0, 5.0, 2.0, 6.0], Some(1)),
+                ([7.0, 10.0, 3.0, 6.0], Some(2)),
+                ([5.0, 7.0, 2.0, 6.0], None),
+                ([7.0, 11.0, 2.0, 3.0], None),
+                ([10.0, 11.0, 3.0, 6.0], None),
+            ]
+        );
+    }
+
+    /// A hole's cells are left out: the plate round a 2 × 2 hole comes in four rectangles.
+    #[test]
+    fn holes_are_left_out() {
+        let faces: Vec<[f64; 4]> = plate(6, 6)
+            .into_iter()
+            .filter(|f| !(f[0] >= 2.0 && f[1] <= 4.0 && f[2] >= 2.0 && f[3] <= 4.0))
+            .collect();
+        let r = rectangles(&faces, &[], 1e-9);
+        let area: f64 = r
+            .iter()
+            .map(|x| (x.chart[1] - x.chart[0]) * (x.chart[3] - x.chart[2]))
+            .sum();
+        assert_eq!(r.len(), 4, "{:?}", charts(&r));
+        assert_eq!(area, 32.0);
+    }
+
+    /// Sides move over strips narrower than the reach to the domain's edge and to another
+    /// box's side, never into a hole or another box, and not over wider strips.
+    #[test]
+    fn boxes_grow_over_thin_strips_only() {
+        let faces: Vec<[f64; 4]> = plate(11, 8)
+            .into_iter()
+            .filter(|f| !(f[0] == 5.0 && f[2] == 0.0))
+            .collect();
+        let mut boxes = vec![
+            // 0.2 from the left edge, 0.3 above the hole's top (t 1), its top 0.1 above
+            // the second box's.
+            (1, [0.2, 4.5, 1.3, 6.0]),
+            // 0.5 from the right edge (wider than the reach), 0.6 below the top.
+            (2, [6.0, 10.5, 3.0, 5.9]),
+        ];
+        grow_over_strips(&faces, &mut boxes, &[[0.4, 0.4], [0.4, 0.4]], 1e-9);
+        // The first box's bottom stays: the strip below it reaches the hole's top only
+        // at s 5, outside its extent, and the plate's bottom (t 0) is beyond reach.
+        assert_eq!(boxes[0].1, [0.0, 4.5, 1.3, 6.0]);
+        assert_eq!(boxes[1].1, [6.0, 10.5, 3.0, 6.0]);
+        // A box whose strip below reaches into a hole does not grow over it.
+        let mut over_hole = vec![(1, [4.5, 5.5, 1.2, 3.0])];
+        grow_over_strips(&faces, &mut over_hole, &[[0.0, 2.0]], 1e-9);
+        assert_eq!(over_hole[0].1, [4.5, 5.5, 1.0, 3.0]);
+        // Nor into another box.
+        let mut pair = vec![(1, [1.0, 3.0, 1.0, 3.0]), (2, [1.0, 3.0, 3.2, 5.0])];
+        grow_over_strips(&faces, &mut pair, &[[0.0, 0.5], [0.0, 0.5]], 1e-9);
+        assert_eq!(pair[0].1, [1.0, 3.0, 1.0, 3.2]);
+        assert_eq!(pair[1].1, [1.0, 3.0, 3.2, 5.0]);
+    }
 }
