@@ -138,6 +138,35 @@ fn no_rectangle_is_a_thin_strip_beside_a_feature_box() {
     }
 }
 
+/// Bike.tsm's domain is slit from one side to a third of the way: merged largest first,
+/// its rest came in two full-height halves and a sliver below the slit, cut in 2 passes,
+/// and the plan was 16 % longer (3 741 against 3 220 mm at r 0.5, h 0.01 mm). The merge
+/// whose rectangles need the shorter cut is taken: no rectangle there is narrower than the
+/// ball.
+#[test]
+fn a_slit_domain_is_cut_without_a_sliver() {
+    let m = public_tsm("Bike.tsm");
+    for strategy in [Strategy::Watershed, Strategy::MultiRectangle] {
+        let o = opts(strategy).with_tool_radius(0.5).with_scallop(0.01);
+        let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
+        let cut = m.with_layout(planned.layout.clone().unwrap());
+        for view in isoparametric::patch_views(&cut) {
+            let [a, b] = sides_mm(&view);
+            println!(
+                "Bike.tsm {}: rectangle {} is {a:.2} x {b:.2} mm",
+                strategy.name(),
+                view.index
+            );
+            assert!(
+                a.min(b) >= 2.0 * o.tool_radius_mm,
+                "{}: rectangle {} is {a:.2} x {b:.2} mm",
+                strategy.name(),
+                view.index
+            );
+        }
+    }
+}
+
 /// Eq. 21–22: each rectangle cut along its longer side reverses no more often in total than
 /// the same rectangles all cut one way.
 #[test]
@@ -159,14 +188,15 @@ fn the_direction_rule_reverses_least() {
 /// Issue 15: the order's transit corners turned rectangles across to link them without a
 /// retraction, against the direction rule: on bumps-hole (r 1, h 0.01 mm) a 3 × 43 mm
 /// background strip was cut in 174 passes across instead of 14 along, and the plan
-/// reversed 1 013 times against the multi-rectangle baseline's 628 of the time. Every
-/// rectangle now keeps the rule's direction (a retraction where the corners cannot meet).
-/// The path stays within 5 % of the baseline's (issue 15's target; at h 0.01 mm 18 808
-/// against 18 711 mm, at h 0.05 mm 9 006 against 8 764 mm). The baseline, its rest merged
-/// largest first like the watershed's, now reverses less (357 and 166 against 472 and
-/// 216): that comparison is printed, not asserted.
+/// reversed 1 013 times against the multi-rectangle baseline's 628. Every rectangle now
+/// keeps the rule's direction (a retraction where the corners cannot meet), which reverses
+/// less than the baseline there (472 against 623; at h 0.05 mm 216 against 286) with the
+/// path within 5 % of the baseline's (issue 15's target; +1.0 % and +3.2 %). Merged
+/// largest first, the baseline's rest would reverse 357 and 166 times; both strategies
+/// take the merge whose rectangles need the shorter cut, and for the baseline that is row
+/// by row here (8 545 against 8 588 mm at h 0.05 mm).
 #[test]
-fn rectangles_keep_the_rule_direction_and_bumps_hole_stays_within_5_percent_of_the_baseline() {
+fn rectangles_keep_the_rule_direction_and_bumps_hole_reverses_less_than_the_baseline() {
     let m = samples::load_sample("bumps-hole").unwrap();
     let plan_with = |strategy| {
         let o = opts(strategy).with_scallop(0.01);
@@ -216,6 +246,7 @@ fn rectangles_keep_the_rule_direction_and_bumps_hole_stays_within_5_percent_of_t
         baseline.retractions,
         baseline.length_mm
     );
+    assert!(report.reversals < baseline.reversals);
     assert!(report.length_mm <= 1.05 * baseline.length_mm);
     let at_005 = |strategy| {
         let o = opts(strategy);
@@ -229,6 +260,7 @@ fn rectangles_keep_the_rule_direction_and_bumps_hole_stays_within_5_percent_of_t
         "h 0.05: watershed {} reversals, {:.0} mm; multi-rectangle {} reversals, {:.0} mm",
         own.reversals, own.length_mm, base.reversals, base.length_mm
     );
+    assert!(own.reversals < base.reversals);
     assert!(own.length_mm <= 1.05 * base.length_mm);
 }
 

@@ -18,7 +18,7 @@ use super::toolpath::{PatchRun, Toolpath};
 use super::PlanOptions;
 use crate::error::{Error, Result};
 use crate::geom::{dist_to_segment, Point3, Vector3};
-use crate::layout::{ConnectionKind, Patch, PatchLine};
+use crate::layout::{ConnectionKind, Patch, PatchLayout, PatchLine};
 use crate::model::Model;
 use crate::surface::diffgeom::unit_normal;
 use crate::surface::{DiffGeom, Surface, SurfaceDerivs};
@@ -84,8 +84,13 @@ pub struct PatchView<'a> {
 
 /// The patch views of `model`, seen from the side the tool works from.
 pub fn patch_views(model: &Model) -> Vec<PatchView<'_>> {
-    model
-        .layout
+    layout_views(model, &model.layout)
+}
+
+/// The patches of `layout` (another layout of `model`'s surface) as [`patch_views`] gives
+/// its own.
+pub fn layout_views<'a>(model: &'a Model, layout: &'a PatchLayout) -> Vec<PatchView<'a>> {
+    layout
         .patches
         .iter()
         .enumerate()
@@ -851,7 +856,26 @@ pub fn patch_costs(model: &Model) -> CostMatrix {
 /// `c` is about the length of one pass times the number of passes, which goes with the
 /// length across; so the shorter path crosses the longer way.
 pub fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
-    let len = |along_u: bool| -> f64 {
+    let [len_u, len_v] = side_totals(view);
+    // Passes along u (crossfeed V) are as long as the u-lines; there are as many as the
+    // v-extent needs: the path length is about len_u · len_v / g either way, but fewer, longer
+    // passes mean fewer reversals, so cut along the longer direction.
+    if len_u >= len_v {
+        Crossfeed::V
+    } else {
+        Crossfeed::U
+    }
+}
+
+/// Lengths (mm) of a patch's sides on the surface, `[along u, along v]`: the mean of the
+/// iso-lines at a quarter, half and three quarters across, each in 16 chords.
+pub fn side_lengths_mm(view: &PatchView) -> [f64; 2] {
+    side_totals(view).map(|t| t / 3.0)
+}
+
+/// The three iso-lines' lengths of [`side_lengths_mm`], summed.
+fn side_totals(view: &PatchView) -> [f64; 2] {
+    [true, false].map(|along_u| {
         let mut total = 0.0;
         for w in [0.25, 0.5, 0.75] {
             let mut prev = if along_u {
@@ -871,15 +895,7 @@ pub fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
             }
         }
         total
-    };
-    // Passes along u (crossfeed V) are as long as the u-lines; there are as many as the
-    // v-extent needs: the path length is about len_u · len_v / g either way, but fewer, longer
-    // passes mean fewer reversals, so cut along the longer direction.
-    if len(true) >= len(false) {
-        Crossfeed::V
-    } else {
-        Crossfeed::U
-    }
+    })
 }
 
 /// Plans the whole model: the zig-zags ([`draft`]) through the shared pipeline (tool

@@ -218,11 +218,15 @@ impl Features {
     }
 
     /// The domain in rectangles: the feature `boxes` (from [`Features::boxes`]) and maximal
-    /// rectangles of the rest (see [`rects`]).
-    pub fn rectangles(&self, boxes: &[(u32, boxes::GridBox, [f64; 4])]) -> Vec<rects::ChartRect> {
+    /// rectangles of the rest, merged by `merge` (see [`rects`]).
+    pub fn rectangles(
+        &self,
+        boxes: &[(u32, boxes::GridBox, [f64; 4])],
+        merge: rects::Merge,
+    ) -> Vec<rects::ChartRect> {
         let boxes: Vec<(u32, [f64; 4])> = boxes.iter().map(|&(l, _, r)| (l, r)).collect();
         let chart = &self.map.chart;
-        rects::rectangles(&chart.face_rects, &boxes, chart.line_tol())
+        rects::rectangles(&chart.face_rects, &boxes, chart.line_tol(), merge)
     }
 
     /// The model's T-mesh refined so that every feature box edge at `tor` is a T-mesh
@@ -330,11 +334,14 @@ mod tests {
     /// and every feature box is covered by rectangles of its feature.
     #[test]
     fn rectangles_partition_the_domain_into_patches() {
-        for name in ["bumps", "bumps-hole"] {
+        for (name, merge) in ["bumps", "bumps-hole"]
+            .into_iter()
+            .flat_map(|n| [rects::Merge::Rows, rects::Merge::Largest].map(|m| (n, m)))
+        {
             let m = samples::load_sample(name).unwrap();
             let f = features(&m, map::DEFAULT_PER_UNIT).unwrap();
             let boxes = f.boxes(DEFAULT_TOR);
-            let rects = f.rectangles(&boxes);
+            let rects = f.rectangles(&boxes, merge);
             let area = |r: &[f64; 4]| (r[1] - r[0]) * (r[3] - r[2]);
             let domain: f64 = f.map.chart.face_rects.iter().map(area).sum();
             let total: f64 = rects.iter().map(|r| area(&r.chart)).sum();
@@ -417,7 +424,7 @@ mod tests {
                 }
             }
             println!(
-                "{name}: {} features, {} boxes, {} rectangles ({featured} of features)",
+                "{name} ({merge:?}): {} features, {} boxes, {} rectangles ({featured} of features)",
                 f.features.len(),
                 boxes.len(),
                 rects.len()

@@ -6,6 +6,7 @@
 //! pipeline.
 
 use super::layer::{FillKind, Layer};
+use super::rects::{ChartRect, Merge};
 use super::{features, map, rects, FeatureKind, DEFAULT_TOR};
 use crate::error::{Error, Result};
 use crate::layout::PatchLayout;
@@ -51,6 +52,82 @@ pub const STRIP_SIDE_STEPS: f64 = 4.0;
 /// Samples per side of a rectangle for its area.
 const AREA_SAMPLES: usize = 16;
 
+/// The domain cut into rectangles, ready to plan: the rectangles, their layout and the
+/// crossfeed each is cut with.
+struct Cut {
+    rects: Vec<ChartRect>,
+    layout: PatchLayout,
+    crossfeeds: Vec<Crossfeed>,
+}
+
+impl Cut {
+    /// `rects` of `model`'s `chart` as patches, each with the crossfeed of the watershed
+    /// (`with_features`: along its longer side, eq. 21–22) or of the baseline (one way for
+    /// all, the way most of the area prefers), unless `opts` gives one.
+    fn new(
+        model: &Model,
+        chart: &map::Chart,
+        rects: Vec<ChartRect>,
+        opts: &PlanOptions,
+        with_features: bool,
+    ) -> Result<Self> {
+        let rect_charts: Vec<[f64; 4]> = rects.iter().map(|r| r.chart).collect();
+        let layout = PatchLayout::from_chart_rects(&model.surface, &chart.placements, &rect_charts)
+            .ok_or_else(|| Error::Degenerate {
+                location: "the domain's rectangles".into(),
+                message: "a rectangle of the domain is not filled by faces".into(),
+            })?;
+        let own: Vec<Crossfeed> = isoparametric::layout_views(model, &layout)
+            .iter()
+            .map(isoparametric::preferred_crossfeed)
+            .collect();
+        let crossfeeds: Vec<Crossfeed> = match (opts.crossfeed, with_features) {
+            (Some(c), _) => vec![c; own.len()],
+            (None, true) => own,
+            (None, false) => {
+                let area = |k: usize| {
+                    let r = &rect_charts[k];
+                    (r[1] - r[0]) * (r[3] - r[2])
+                };
+                let along_u: f64 = (0..own.len())
+                    .filter(|&k| own[k] == Crossfeed::V)
+                    .map(area)
+                    .sum();
+                let total: f64 = (0..own.len()).map(area).sum();
+                let c = if 2.0 * along_u >= total {
+                    Crossfeed::V
+                } else {
+                    Crossfeed::U
+                };
+                vec![c; own.len()]
+            }
+        };
+        Ok(Cut {
+            rects,
+            layout,
+            crossfeeds,
+        })
+    }
+
+    /// Estimated cutting length (mm) on `model`: per rectangle, passes `step` (mm) apart
+    /// across it and one more, each as long as the side it runs along.
+    fn estimated_path_mm(&self, model: &Model, step: f64) -> f64 {
+        isoparametric::layout_views(model, &self.layout)
+            .iter()
+            .zip(&self.crossfeeds)
+            .map(|(view, c)| {
+                let [along_u, along_v] = isoparametric::side_lengths_mm(view);
+                // Crossfeed V: passes along u, stepping across v.
+                let (along, across) = match c {
+                    Crossfeed::V => (along_u, along_v),
+                    Crossfeed::U => (along_v, along_u),
+                };
+                ((across / step).ceil() + 1.0) * along
+            })
+            .sum()
+    }
+}
+
 /// Plans `model` with the watershed strategy (`with_features`) or its multi-rectangle
 /// baseline. Errors on a model whose domain does not lie flat in one chart.
 pub fn plan(
@@ -61,7 +138,7 @@ pub fn plan(
 ) -> Result<Planned> {
     opts.validate()?;
     // The feature boxes and rectangles, or for the baseline the domain's rectangles alone.
-    let (chart, rects, regions, map_points) = if with_features {
+    let (chart, boxes, regions, map_points) = if with_features {
         let found = features(model, map::DEFAULT_PER_UNIT)?;
         // A region's boxes that hold less than SMALL_BOX_SHARE of its largest box are cut
         // with the rest: PolyBoundingBox boxes the few grid steps where a region juts out
@@ -113,10 +190,6 @@ pub fn plan(
             &reach,
             found.map.chart.line_tol(),
         );
-        for (b, (_, c)) in boxes.iter_mut().zip(charts) {
-            b.2 = c;
-        }
-        let rects = found.rectangles(&boxes);
         let regions: Vec<RegionReport> = found
             .features
             .iter()
@@ -127,46 +200,30 @@ pub fn plan(
             })
             .collect();
         let points = [found.map.valid.nx, found.map.valid.ny];
-        (found.map.chart, rects, Some(regions), Some(points))
+        (found.map.chart, charts, Some(regions), Some(points))
     } else {
         let chart = map::chart(&model.mesh, &model.surface)?;
-        let rects = rects::rectangles(&chart.face_rects, &[], chart.line_tol());
-        (chart, rects, None, None)
+        (chart, Vec::new(), None, None)
     };
-    let rect_charts: Vec<[f64; 4]> = rects.iter().map(|r| r.chart).collect();
-    let layout = PatchLayout::from_chart_rects(&model.surface, &chart.placements, &rect_charts)
-        .ok_or_else(|| Error::Degenerate {
-            location: "the domain's rectangles".into(),
-            message: "a rectangle of the domain is not filled by faces".into(),
-        })?;
+    // The rest merged both ways; the merge whose rectangles need the shorter path (passes
+    // a flat side step apart, as long as the side they run along) is cut.
+    let step = stepover::side_step_clamped(opts.scallop_mm, opts.tool_radius_mm, 0.0);
+    let candidate = |merge| {
+        let rects = rects::rectangles(&chart.face_rects, &boxes, chart.line_tol(), merge);
+        Cut::new(model, &chart, rects, opts, with_features)
+    };
+    let (largest, rows) = (candidate(Merge::Largest)?, candidate(Merge::Rows)?);
+    // (An estimate that is not a number is no better than the other.)
+    let Cut {
+        rects,
+        layout,
+        crossfeeds,
+    } = if rows.estimated_path_mm(model, step) < largest.estimated_path_mm(model, step) {
+        rows
+    } else {
+        largest
+    };
     let cut = model.with_layout(layout);
-    // Along the longer side per rectangle (eq. 21–22); the baseline one way for all, the
-    // way most of the area prefers.
-    let own: Vec<Crossfeed> = isoparametric::patch_views(&cut)
-        .iter()
-        .map(isoparametric::preferred_crossfeed)
-        .collect();
-    let crossfeeds: Vec<Crossfeed> = match (opts.crossfeed, with_features) {
-        (Some(c), _) => vec![c; own.len()],
-        (None, true) => own,
-        (None, false) => {
-            let area = |k: usize| {
-                let r = &rect_charts[k];
-                (r[1] - r[0]) * (r[3] - r[2])
-            };
-            let along_u: f64 = (0..own.len())
-                .filter(|&k| own[k] == Crossfeed::V)
-                .map(area)
-                .sum();
-            let total: f64 = (0..own.len()).map(area).sum();
-            let c = if 2.0 * along_u >= total {
-                Crossfeed::V
-            } else {
-                Crossfeed::U
-            };
-            vec![c; own.len()]
-        }
-    };
     let name = if with_features {
         "watershed"
     } else {

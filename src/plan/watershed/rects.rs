@@ -3,12 +3,23 @@
 //!
 //! Every face side and box side is extended into a line across the domain's chart; the
 //! cells between the lines are classed by the box holding them (or none), and cells of one
-//! class are merged largest first — of all rectangles of one class's free cells, the one
-//! with the most chart area, again and again — so that a box inside the domain comes out
-//! whole and the rest comes in few, broad rectangles (each rectangle costs the passes at
-//! its sides, and the greedy row-by-row merge this replaced left a one-cell column between
-//! two boxes running up through the strip above them). Cells outside every face (holes,
-//! notches) are left out.
+//! class are merged ([`Merge`]) so that a box inside the domain comes out whole. Cells
+//! outside every face (holes, notches) are left out.
+
+/// How cells of one class are merged into rectangles. Neither is best on every domain:
+/// row by row ran the column between bumps' two boxes up through the strip above them
+/// (8 rectangles where largest first makes 7), largest first cut Bike.tsm's slit domain
+/// into two full-height halves and a sliver beside the slit (its plan 16 % longer); the
+/// planner takes the one whose rectangles need the shorter path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Merge {
+    /// From the lowest row up, leftmost first: as wide as the class runs, then as high as
+    /// the whole width stays in the class.
+    Rows,
+    /// Of all rectangles of one class's free cells, the one with the most chart area (the
+    /// lowest, then leftmost, then narrowest of equal ones), again and again.
+    Largest,
+}
 
 /// A rectangle of the domain's chart and the feature region it belongs to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,9 +31,14 @@ pub struct ChartRect {
 }
 
 /// The rectangles of the domain made of `faces` (chart rectangles) with the feature
-/// `boxes` (label, chart rectangle; not overlapping) in it; `tol` is the distance (knot
-/// units) within which two lines are one.
-pub fn rectangles(faces: &[[f64; 4]], boxes: &[(u32, [f64; 4])], tol: f64) -> Vec<ChartRect> {
+/// `boxes` (label, chart rectangle; not overlapping) in it, cells merged by `merge`; `tol`
+/// is the distance (knot units) within which two lines are one.
+pub fn rectangles(
+    faces: &[[f64; 4]],
+    boxes: &[(u32, [f64; 4])],
+    tol: f64,
+    merge: Merge,
+) -> Vec<ChartRect> {
     let mut lines = [Vec::new(), Vec::new()];
     for r in faces.iter().chain(boxes.iter().map(|b| &b.1)) {
         lines[0].extend([r[0], r[1]]);
@@ -57,8 +73,68 @@ pub fn rectangles(faces: &[[f64; 4]], boxes: &[(u32, [f64; 4])], tol: f64) -> Ve
             }
         }
     }
-    // Largest first: of the rectangles of one class not yet taken, the one with the most
-    // chart area (the lowest, then leftmost, of equal ones), until every cell is taken.
+    let picked = match merge {
+        Merge::Rows => by_rows(ns, nt, &class),
+        Merge::Largest => largest_first(&lines, ns, nt, &class),
+    };
+    picked
+        .into_iter()
+        .map(|[i0, i1, j0, j1]| {
+            let c = class[j0 * ns + i0].unwrap_or(0);
+            ChartRect {
+                chart: [
+                    lines[0][i0],
+                    lines[0][i1 + 1],
+                    lines[1][j0],
+                    lines[1][j1 + 1],
+                ],
+                feature: (c != 0).then_some(c),
+            }
+        })
+        .collect()
+}
+
+/// [`Merge::Rows`] on an `ns × nt` grid of cell classes (row-major): the rectangles as
+/// `[i0, i1, j0, j1]` cell ranges.
+fn by_rows(ns: usize, nt: usize, class: &[Option<u32>]) -> Vec<[usize; 4]> {
+    let mut taken = vec![false; ns * nt];
+    let mut out = Vec::new();
+    for j in 0..nt {
+        for i in 0..ns {
+            let Some(c) = class[j * ns + i] else { continue };
+            if taken[j * ns + i] {
+                continue;
+            }
+            let free = |a: usize, b: usize, taken: &[bool]| {
+                class[b * ns + a] == Some(c) && !taken[b * ns + a]
+            };
+            let mut i1 = i;
+            while i1 + 1 < ns && free(i1 + 1, j, &taken) {
+                i1 += 1;
+            }
+            let mut j1 = j;
+            while j1 + 1 < nt && (i..=i1).all(|a| free(a, j1 + 1, &taken)) {
+                j1 += 1;
+            }
+            for b in j..=j1 {
+                for a in i..=i1 {
+                    taken[b * ns + a] = true;
+                }
+            }
+            out.push([i, i1, j, j1]);
+        }
+    }
+    out
+}
+
+/// [`Merge::Largest`] on the `ns × nt` cells between `lines` (`[s lines, t lines]`) of
+/// classes `class` (row-major): the rectangles as `[i0, i1, j0, j1]` cell ranges.
+fn largest_first(
+    lines: &[Vec<f64>; 2],
+    ns: usize,
+    nt: usize,
+    class: &[Option<u32>],
+) -> Vec<[usize; 4]> {
     let width = |i: usize| lines[0][i + 1] - lines[0][i];
     let mut taken = vec![false; ns * nt];
     let mut out = Vec::new();
@@ -75,7 +151,7 @@ pub fn rectangles(faces: &[[f64; 4]], boxes: &[(u32, [f64; 4])], tol: f64) -> Ve
             }
         }
         // (area, i0, i1, j0, j1) of the best so far.
-        let mut best: Option<(f64, usize, usize, usize, usize)> = None;
+        let mut best: Option<(f64, [usize; 4])> = None;
         for j in 0..nt {
             for i in 0..ns {
                 let c = j * ns + i;
@@ -92,29 +168,20 @@ pub fn rectangles(faces: &[[f64; 4]], boxes: &[(u32, [f64; 4])], tol: f64) -> Ve
                     w += width(i1);
                     let h = lines[1][j + rows] - lines[1][j];
                     if best.is_none_or(|b| w * h > b.0) {
-                        best = Some((w * h, i, i1, j, j + rows - 1));
+                        best = Some((w * h, [i, i1, j, j + rows - 1]));
                     }
                 }
             }
         }
-        let Some((_, i0, i1, j0, j1)) = best else {
+        let Some((_, r)) = best else {
             break;
         };
-        for b in j0..=j1 {
-            for a in i0..=i1 {
+        for b in r[2]..=r[3] {
+            for a in r[0]..=r[1] {
                 taken[b * ns + a] = true;
             }
         }
-        let c = class[j0 * ns + i0].unwrap_or(0);
-        out.push(ChartRect {
-            chart: [
-                lines[0][i0],
-                lines[0][i1 + 1],
-                lines[1][j0],
-                lines[1][j1 + 1],
-            ],
-            feature: (c != 0).then_some(c),
-        });
+        out.push(r);
     }
     out
 }
@@ -237,7 +304,7 @@ mod tests {
     #[test]
     fn the_rest_comes_in_few_broad_rectangles() {
         let boxes = [(1, [0.0, 5.0, 2.0, 6.0]), (2, [7.0, 10.0, 3.0, 6.0])];
-        let r = rectangles(&plate(11, 8), &boxes, 1e-9);
+        let r = rectangles(&plate(11, 8), &boxes, 1e-9, Merge::Largest);
         assert_eq!(
             charts(&r),
             vec![
@@ -252,6 +319,46 @@ mod tests {
         );
     }
 
+    /// Row by row, the same plate comes in eight rectangles: the column between the boxes
+    /// runs up through the strip above them.
+    #[test]
+    fn row_by_row_the_column_runs_up_through_the_strip() {
+        let boxes = [(1, [0.0, 5.0, 2.0, 6.0]), (2, [7.0, 10.0, 3.0, 6.0])];
+        let r = rectangles(&plate(11, 8), &boxes, 1e-9, Merge::Rows);
+        assert_eq!(r.len(), 8, "{:?}", charts(&r));
+        assert!(charts(&r).contains(&([5.0, 7.0, 3.0, 8.0], None)));
+    }
+
+    /// A plate slit from the top down to a third of its height (Bike.tsm's domain): row by
+    /// row, a strip below the slit and the two sides above it; largest first, the two
+    /// full-height sides and a sliver as wide as the slit below it.
+    #[test]
+    fn largest_first_leaves_a_sliver_below_a_slit() {
+        let faces: Vec<[f64; 4]> = [[0.0, 4.9], [4.9, 5.1], [5.1, 10.0]]
+            .iter()
+            .flat_map(|s| [[0.0, 3.0], [3.0, 10.0]].map(|t| [s[0], s[1], t[0], t[1]]))
+            .filter(|f| !(f[0] == 4.9 && f[2] == 3.0))
+            .collect();
+        let rows = rectangles(&faces, &[], 1e-9, Merge::Rows);
+        assert_eq!(
+            charts(&rows),
+            vec![
+                ([0.0, 10.0, 0.0, 3.0], None),
+                ([0.0, 4.9, 3.0, 10.0], None),
+                ([5.1, 10.0, 3.0, 10.0], None),
+            ]
+        );
+        let largest = rectangles(&faces, &[], 1e-9, Merge::Largest);
+        assert_eq!(
+            charts(&largest),
+            vec![
+                ([0.0, 4.9, 0.0, 10.0], None),
+                ([5.1, 10.0, 0.0, 10.0], None),
+                ([4.9, 5.1, 0.0, 3.0], None),
+            ]
+        );
+    }
+
     /// A hole's cells are left out: the plate round a 2 × 2 hole comes in four rectangles.
     #[test]
     fn holes_are_left_out() {
@@ -259,13 +366,15 @@ mod tests {
             .into_iter()
             .filter(|f| !(f[0] >= 2.0 && f[1] <= 4.0 && f[2] >= 2.0 && f[3] <= 4.0))
             .collect();
-        let r = rectangles(&faces, &[], 1e-9);
-        let area: f64 = r
-            .iter()
-            .map(|x| (x.chart[1] - x.chart[0]) * (x.chart[3] - x.chart[2]))
-            .sum();
-        assert_eq!(r.len(), 4, "{:?}", charts(&r));
-        assert_eq!(area, 32.0);
+        for merge in [Merge::Rows, Merge::Largest] {
+            let r = rectangles(&faces, &[], 1e-9, merge);
+            let area: f64 = r
+                .iter()
+                .map(|x| (x.chart[1] - x.chart[0]) * (x.chart[3] - x.chart[2]))
+                .sum();
+            assert_eq!(r.len(), 4, "{merge:?}: {:?}", charts(&r));
+            assert_eq!(area, 32.0);
+        }
     }
 
     /// Sides move over strips narrower than the reach to the domain's edge and to another
