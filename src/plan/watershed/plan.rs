@@ -137,7 +137,10 @@ pub fn plan(
     with_features: bool,
 ) -> Result<Planned> {
     opts.validate()?;
-    // The feature boxes and rectangles, or for the baseline the domain's rectangles alone.
+    // The flat side step (mm), the unit of the strips given to boxes and of the estimate
+    // that picks the merge.
+    let step = stepover::side_step_clamped(opts.scallop_mm, opts.tool_radius_mm, 0.0);
+    // The feature boxes grown over thin strips, or for the baseline none.
     let (chart, boxes, regions, map_points) = if with_features {
         let found = features(model, map::DEFAULT_PER_UNIT)?;
         // A region's boxes that hold less than SMALL_BOX_SHARE of its largest box are cut
@@ -167,7 +170,6 @@ pub fn plan(
         boxes.retain(|_| !small.next().unwrap_or(false));
         // Strips narrower than STRIP_SIDE_STEPS flat side steps between a box and the
         // domain's edge, a hole or another box's side go to the box.
-        let step = stepover::side_step_clamped(opts.scallop_mm, opts.tool_radius_mm, 0.0);
         let reach: Vec<[f64; 2]> = boxes
             .iter()
             .map(|(_, g, c)| {
@@ -207,7 +209,6 @@ pub fn plan(
     };
     // The rest merged both ways; the merge whose rectangles need the shorter path (passes
     // a flat side step apart, as long as the side they run along) is cut.
-    let step = stepover::side_step_clamped(opts.scallop_mm, opts.tool_radius_mm, 0.0);
     let candidate = |merge| {
         let rects = rects::rectangles(&chart.face_rects, &boxes, chart.line_tol(), merge);
         Cut::new(model, &chart, rects, opts, with_features)
