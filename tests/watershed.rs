@@ -465,7 +465,7 @@ fn the_rectangles_layer_tiles_the_surface_and_points_along_the_passes() {
 
 /// Passes running past an extraordinary point keep the scallop: bumps-hole cut in four
 /// rectangles whose long sides run through the hole's corners (the multi-rectangle
-/// baseline's layout once the rest is merged largest first). The side step, sampled
+/// baseline's layout when its rest is merged largest first). The side step, sampled
 /// evenly along the passes and densely only near their ends, missed the stretch next to
 /// the corners, and the cut left 0.085 mm where 0.05 mm was asked; each patch's singular
 /// points now add samples round them.
