@@ -856,10 +856,14 @@ pub fn patch_costs(model: &Model) -> CostMatrix {
 /// `c` is about the length of one pass times the number of passes, which goes with the
 /// length across; so the shorter path crosses the longer way.
 pub fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
-    let [len_u, len_v] = side_totals(view);
-    // Passes along u (crossfeed V) are as long as the u-lines; there are as many as the
-    // v-extent needs: the path length is about len_u · len_v / g either way, but fewer, longer
-    // passes mean fewer reversals, so cut along the longer direction.
+    longer_side_crossfeed(side_lengths_mm(view))
+}
+
+/// The crossfeed that cuts along the longer of a patch's sides (`[along u, along v]`, mm):
+/// passes along u (crossfeed V) are as long as the u-lines, and there are as many as the
+/// v-extent needs; the path length is about len_u · len_v / g either way, but fewer, longer
+/// passes mean fewer reversals.
+pub fn longer_side_crossfeed([len_u, len_v]: [f64; 2]) -> Crossfeed {
     if len_u >= len_v {
         Crossfeed::V
     } else {
@@ -870,11 +874,6 @@ pub fn preferred_crossfeed(view: &PatchView) -> Crossfeed {
 /// Lengths (mm) of a patch's sides on the surface, `[along u, along v]`: the mean of the
 /// iso-lines at a quarter, half and three quarters across, each in 16 chords.
 pub fn side_lengths_mm(view: &PatchView) -> [f64; 2] {
-    side_totals(view).map(|t| t / 3.0)
-}
-
-/// The three iso-lines' lengths of [`side_lengths_mm`], summed.
-fn side_totals(view: &PatchView) -> [f64; 2] {
     [true, false].map(|along_u| {
         let mut total = 0.0;
         for w in [0.25, 0.5, 0.75] {
@@ -894,7 +893,7 @@ fn side_totals(view: &PatchView) -> [f64; 2] {
                 prev = p;
             }
         }
-        total
+        total / 3.0
     })
 }
 

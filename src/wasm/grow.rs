@@ -9,7 +9,8 @@
 //! of one step is allocated and freed at once: dlmalloc grows the memory by the step in one
 //! call and keeps the block as free memory for what comes next. The step is a share of the
 //! memory already there (1/32), so growing from `M0` to `M` bytes takes about
-//! `32 ln(M / M0)` calls (about 120 from 4 to 186 MB), and at most one step is left unused. Natively the standard allocator is used as it is.
+//! `32 ln(M / M0)` calls (about 120 from 4 to 186 MB), and at most one step is left
+//! unused. Natively the standard allocator is used as it is.
 
 use std::alloc::{GlobalAlloc, Layout};
 use std::arch::wasm32::memory_size;

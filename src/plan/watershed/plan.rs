@@ -52,11 +52,13 @@ pub const STRIP_SIDE_STEPS: f64 = 4.0;
 /// Samples per side of a rectangle for its area.
 const AREA_SAMPLES: usize = 16;
 
-/// The domain cut into rectangles, ready to plan: the rectangles, their layout and the
-/// crossfeed each is cut with.
+/// The domain cut into rectangles, ready to plan: the rectangles, their layout, their
+/// sides on the surface and the crossfeed each is cut with.
 struct Cut {
     rects: Vec<ChartRect>,
     layout: PatchLayout,
+    /// Per rectangle, `[along u, along v]` (mm, [`isoparametric::side_lengths_mm`]).
+    sides_mm: Vec<[f64; 2]>,
     crossfeeds: Vec<Crossfeed>,
 }
 
@@ -77,9 +79,13 @@ impl Cut {
                 location: "the domain's rectangles".into(),
                 message: "a rectangle of the domain is not filled by faces".into(),
             })?;
-        let own: Vec<Crossfeed> = isoparametric::layout_views(model, &layout)
+        let sides_mm: Vec<[f64; 2]> = isoparametric::layout_views(model, &layout)
             .iter()
-            .map(isoparametric::preferred_crossfeed)
+            .map(isoparametric::side_lengths_mm)
+            .collect();
+        let own: Vec<Crossfeed> = sides_mm
+            .iter()
+            .map(|&s| isoparametric::longer_side_crossfeed(s))
             .collect();
         let crossfeeds: Vec<Crossfeed> = match (opts.crossfeed, with_features) {
             (Some(c), _) => vec![c; own.len()],
@@ -105,18 +111,18 @@ impl Cut {
         Ok(Cut {
             rects,
             layout,
+            sides_mm,
             crossfeeds,
         })
     }
 
-    /// Estimated cutting length (mm) on `model`: per rectangle, passes `step` (mm) apart
-    /// across it and one more, each as long as the side it runs along.
-    fn estimated_path_mm(&self, model: &Model, step: f64) -> f64 {
-        isoparametric::layout_views(model, &self.layout)
+    /// Estimated cutting length (mm): per rectangle, passes `step` (mm) apart across it and
+    /// one more, each as long as the side it runs along.
+    fn estimated_path_mm(&self, step: f64) -> f64 {
+        self.sides_mm
             .iter()
             .zip(&self.crossfeeds)
-            .map(|(view, c)| {
-                let [along_u, along_v] = isoparametric::side_lengths_mm(view);
+            .map(|(&[along_u, along_v], c)| {
                 // Crossfeed V: passes along u, stepping across v.
                 let (along, across) = match c {
                     Crossfeed::V => (along_u, along_v),
@@ -219,7 +225,8 @@ pub fn plan(
         rects,
         layout,
         crossfeeds,
-    } = if rows.estimated_path_mm(model, step) < largest.estimated_path_mm(model, step) {
+        ..
+    } = if rows.estimated_path_mm(step) < largest.estimated_path_mm(step) {
         rows
     } else {
         largest

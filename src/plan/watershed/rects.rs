@@ -209,8 +209,6 @@ pub fn grow_over_strips(
             a[3].min(b[3]),
         ]
     };
-    let lo = [0, 2].map(|k| faces.iter().map(|f| f[k]).fold(f64::INFINITY, f64::min));
-    let hi = [1, 3].map(|k| faces.iter().map(|f| f[k]).fold(f64::NEG_INFINITY, f64::max));
     for k in 0..boxes.len() {
         // Sides: index into the box (0 s0, 1 s1, 2 t0, 3 t1); the axis; the outward sign.
         for side in 0..4 {
@@ -243,9 +241,10 @@ pub fn grow_over_strips(
                     .sum();
                 covered < (c1 - c0) - tol
             };
-            // Lines beyond the side within reach: the domain's bound, face sides where the
-            // domain ends beyond them, and other boxes' sides along the same axis.
-            let mut lines: Vec<f64> = vec![if out > 0.0 { hi[axis] } else { lo[axis] }];
+            // Lines beyond the side within reach: face sides where the domain ends beyond
+            // them (its bound, a hole's or a notch's edge), and other boxes' sides along the
+            // same axis.
+            let mut lines: Vec<f64> = Vec::new();
             for f in faces {
                 let x = f[2 * axis + usize::from(out > 0.0)];
                 if out * (x - at) > tol && out * (x - at) <= limit && ends_at(x) {
