@@ -919,18 +919,25 @@ pub fn draft(
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<Draft> {
-    draft_with(model, opts, progress, None, "isoparametric")
+    draft_with(model, opts, progress, None, &[], "isoparametric")
 }
 
 /// As [`draft`], with each patch's crossfeed given (`crossfeeds`, one per patch; the
 /// option's or the longer side's otherwise), the draft named `strategy`. A crossfeed given
 /// here or in the options is kept even where that costs a retraction; the longer side's
 /// gives way where turning the patch lets the path go on without one.
+///
+/// `seams[k]` (empty: none) says whether patch `k`'s pass on its side at across-parameter
+/// 0 and at 1 is a neighbour's to cut (the neighbour's passes run the same way and it
+/// keeps its pass there, [`crate::plan::watershed::rects::shared_seams`]): that pass is
+/// left out, and the pass one side step in is the first. A patch of two passes leaves
+/// only the first.
 pub fn draft_with(
     model: &Model,
     opts: &PlanOptions,
     progress: &mut dyn FnMut(f64) -> bool,
     crossfeeds: Option<&[Crossfeed]>,
+    seams: &[[bool; 2]],
     strategy: &'static str,
 ) -> Result<Draft> {
     opts.validate()?;
@@ -997,11 +1004,26 @@ pub fn draft_with(
     } else {
         views.iter().map(|_| None).collect()
     };
+    // Per patch, the boundary passes left to neighbours (at across-parameter 0 and 1).
+    let left_out: Vec<[bool; 2]> = (0..np)
+        .map(|k| {
+            let given = seams.get(k).copied().unwrap_or([false; 2]);
+            // A patch of two passes leaving both would have none of its own.
+            let two = |p: &StepProfile| p.passes(h_side).len() <= 2;
+            if given == [true, true] && profiles[k].as_ref().is_none_or(two) {
+                [true, false]
+            } else {
+                given
+            }
+        })
+        .collect();
+    let dropped = |k: usize| left_out[k].iter().filter(|&&x| x).count();
     let natural_odd: Option<Vec<bool>> = strict.then(|| {
         profiles
             .iter()
             .flatten()
-            .map(|p| p.passes(h_side).len() % 2 == 1)
+            .enumerate()
+            .map(|(k, p)| (p.passes(h_side).len() - dropped(k)) % 2 == 1)
             .collect()
     });
     let (transits, forced) = corners::select(
@@ -1025,12 +1047,28 @@ pub fn draft_with(
             Some(p) => p,
             None => StepProfile::new(view, dir, h_side, r)?,
         };
-        let (ws, h_used, pred) = tuned_passes(view, dir, &profile, odd, h_side, r)?;
+        // The passes with those on seams a neighbour cuts: its pass stands for this one's
+        // in the tuning and the checks.
+        let left = left_out[tr.patch];
+        let odd_all = odd != (dropped(tr.patch) % 2 == 1);
+        let (ws, h_used, pred) = tuned_passes(view, dir, &profile, odd_all, h_side, r)?;
         // Eq. 5 sees the curvature of each face, not the kinks between faces (a convex
         // crease between two passes widens their cusp by about r times its angle): the
         // cusps between the passes are computed from the two balls and split where too high.
         let (mut ws, cusp) = cusp_checked(view, dir, ws, h_target, r)?;
         worst = worst.max(pred).max(cusp);
+        if left[1] {
+            ws.pop();
+        }
+        if left[0] {
+            ws.remove(0);
+        }
+        // How far across the first and last passes' strips reach: to the seam where the
+        // pass on it is left out.
+        let mut ends = [
+            if left[0] { 0.0 } else { ws[0] },
+            if left[1] { 1.0 } else { ws[ws.len() - 1] },
+        ];
         // The passes start on the start corner's side and each runs away from the corner's
         // coordinate along the pass first.
         let (w_start, t_start) = match dir {
@@ -1039,6 +1077,7 @@ pub fn draft_with(
         };
         if w_start == 1 {
             ws.reverse();
+            ends.reverse();
         }
         let first_move = out.len();
         let nlines = ws.len();
@@ -1046,11 +1085,15 @@ pub fn draft_with(
         // The strip across the passes each pass stands for: half-way to its neighbours.
         let strip = |li: usize| -> (f64, f64) {
             let w = ws[li];
-            let lo = if li > 0 { 0.5 * (ws[li - 1] + w) } else { w };
+            let lo = if li > 0 {
+                0.5 * (ws[li - 1] + w)
+            } else {
+                ends[0]
+            };
             let hi = if li + 1 < nlines {
                 0.5 * (w + ws[li + 1])
             } else {
-                w
+                ends[1]
             };
             (lo.min(hi), lo.max(hi))
         };

@@ -280,6 +280,70 @@ pub fn grow_over_strips(
     }
 }
 
+/// The boundary passes a neighbour cuts. A rectangle's zig-zag has a pass on each of its
+/// two sides along the passes; where rectangles whose passes run the same way meet along
+/// such sides, one pass along the seam serves both, as the pass one side step in from it
+/// is as far from it as from a pass of the rectangle's own there. For rectangles `rects`
+/// (chart `[s0, s1, t0, t1]`, passes along s where `along_s[k]`, else along t), per
+/// rectangle whether its pass on the low side (t0, or s0) and on the high side is left
+/// to neighbours: the side lies within the opposite sides of neighbours with passes the
+/// same way, on its line, that keep their passes. Rectangles are taken in order, the low
+/// side first; `tol` is the distance (knot units) within which two lines are one.
+pub fn shared_seams(
+    rects: &[[f64; 4]],
+    along_s: &[bool],
+    tol: f64,
+    smooth: &dyn Fn(usize, usize, f64, [f64; 2]) -> bool,
+) -> Vec<[bool; 2]> {
+    let n = rects.len().min(along_s.len());
+    let mut left = vec![[false; 2]; n];
+    let mut kept = vec![[false; 2]; n];
+    // Side `e` of rectangle `k` (0 low, 1 high): its line, and its extent along the line.
+    let side = |k: usize, e: usize| -> (f64, f64, f64) {
+        let r = &rects[k];
+        if along_s[k] {
+            (r[2 + e], r[0], r[1])
+        } else {
+            (r[e], r[2], r[3])
+        }
+    };
+    for k in 0..n {
+        for e in 0..2 {
+            if kept[k][e] {
+                continue;
+            }
+            let (x, a, b) = side(k, e);
+            // Neighbours beyond this side, with passes the same way and their pass on it.
+            let mut cover: Vec<(f64, f64, usize)> = (0..n)
+                .filter(|&j| j != k && along_s[j] == along_s[k] && !left[j][1 - e])
+                .filter_map(|j| {
+                    let (y, c, d) = side(j, 1 - e);
+                    ((y - x).abs() <= tol
+                        && d > a + tol
+                        && c < b - tol
+                        && smooth(k, j, x, [a.max(c), b.min(d)]))
+                    .then_some((c, d, j))
+                })
+                .collect();
+            crate::sort::sort_by(&mut cover, |p, q| p.0.total_cmp(&q.0));
+            let mut reach = a;
+            for &(c, d, _) in &cover {
+                if c > reach + tol {
+                    break;
+                }
+                reach = reach.max(d);
+            }
+            if reach >= b - tol {
+                left[k][e] = true;
+                for &(_, _, j) in &cover {
+                    kept[j][1 - e] = true;
+                }
+            }
+        }
+    }
+    left
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -405,5 +469,83 @@ mod tests {
         grow_over_strips(&faces, &mut pair, &[[0.0, 0.5], [0.0, 0.5]], 1e-9);
         assert_eq!(pair[0].1, [1.0, 3.0, 1.0, 3.2]);
         assert_eq!(pair[1].1, [1.0, 3.0, 3.2, 5.0]);
+    }
+
+    /// bumps' layout (seven rectangles, chart units of mm): the pass along each seam
+    /// between rectangles cut the same way is cut once; seams where the passes meet a side
+    /// end-on, and sides only partly against a neighbour cut the same way, keep theirs.
+    #[test]
+    fn a_seam_between_passes_the_same_way_is_cut_once() {
+        let rects = [
+            [-40.0, -1.27, -18.56, 18.56],
+            [-40.0, 40.0, -30.0, -18.56],
+            [-40.0, 40.0, 18.56, 30.0],
+            [8.91, 34.0, -12.19, 18.56],
+            [-1.27, 8.91, -18.56, 18.56],
+            [34.0, 40.0, -18.56, 18.56],
+            [8.91, 34.0, -18.56, -12.19],
+        ];
+        let along_s = [true, true, true, false, false, false, true];
+        let left = shared_seams(&rects, &along_s, 1e-9, &|_, _, _, _| true);
+        assert_eq!(
+            left,
+            vec![
+                // Both sides: the strips below and above it run the whole width.
+                [true, true],
+                [false, false],
+                // Its bottom is only partly against the first box.
+                [false, false],
+                // Both sides within the columns beside it.
+                [true, true],
+                [false, false],
+                [false, false],
+                // Its top meets the second box's passes end-on.
+                [true, false],
+            ]
+        );
+        // No side left out is the side another one is left to.
+        for (k, l) in left.iter().enumerate() {
+            for e in 0..2 {
+                if l[e] {
+                    let x = if along_s[k] {
+                        rects[k][2 + e]
+                    } else {
+                        rects[k][e]
+                    };
+                    for (j, r) in rects.iter().enumerate() {
+                        let y = if along_s[j] { r[3 - e] } else { r[1 - e] };
+                        if j != k && along_s[j] == along_s[k] && y == x {
+                            assert!(!left[j][1 - e], "{k} and {j} both leave the seam");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Two rectangles of equal sides, cut the same way: the first leaves the seam to the
+    /// second, which keeps it; cut different ways, both keep it.
+    #[test]
+    fn one_of_two_equal_sides_keeps_the_seam() {
+        let rects = [[0.0, 4.0, 0.0, 2.0], [0.0, 4.0, 2.0, 3.0]];
+        assert_eq!(
+            shared_seams(&rects, &[true, true], 1e-9, &|_, _, _, _| true),
+            vec![[false, true], [false, false]]
+        );
+        assert_eq!(
+            shared_seams(&rects, &[true, false], 1e-9, &|_, _, _, _| true),
+            vec![[false, false], [false, false]]
+        );
+        // With a gap between the two above it (a hole), the long side keeps its pass, and
+        // the short ones leave theirs to it.
+        let split = [
+            [0.0, 4.0, 0.0, 2.0],
+            [0.0, 1.5, 2.0, 3.0],
+            [2.5, 4.0, 2.0, 3.0],
+        ];
+        assert_eq!(
+            shared_seams(&split, &[true, true, true], 1e-9, &|_, _, _, _| true),
+            vec![[false, false], [true, false], [true, false]]
+        );
     }
 }
