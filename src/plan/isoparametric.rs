@@ -7,7 +7,8 @@
 //! forward steps keep chords within the chordal tolerance. The number of passes decides the
 //! corner a zig-zag ends at; where it ends at the wrong one the scallop height is tuned down
 //! (by 0.1 h, then by bisection) until one more pass fits. Consecutive patches meet at their
-//! shared corner, joined by a feed move.
+//! shared corner, joined by a feed move (along the side, where a patch leaves the pass on
+//! that side to a neighbour).
 
 use super::corners::{self, Crossfeed};
 use super::draft::{Draft, DraftBuilder, Footprint, SurfacePoint};
@@ -931,7 +932,10 @@ pub fn draft(
 /// 0 and at 1 is a neighbour's to cut (the neighbour's passes run the same way and it
 /// keeps its pass there, [`crate::plan::watershed::rects::shared_seams`]): that pass is
 /// left out, and the pass one side step in is the first. A patch of two passes leaves
-/// only the first.
+/// only the one at across-parameter 0. The transit from the previous patch's finishing
+/// corner, and to the next one's starting corner, runs along the side to the first pass
+/// and from the last. Seams count only with the crossfeeds given (`crossfeeds` or the
+/// options): a patch turned across would leave a pass that is no seam's.
 pub fn draft_with(
     model: &Model,
     opts: &PlanOptions,
@@ -1007,7 +1011,11 @@ pub fn draft_with(
     // Per patch, the boundary passes left to neighbours (at across-parameter 0 and 1).
     let left_out: Vec<[bool; 2]> = (0..np)
         .map(|k| {
-            let given = seams.get(k).copied().unwrap_or([false; 2]);
+            let given = seams
+                .get(k)
+                .copied()
+                .filter(|_| strict)
+                .unwrap_or([false; 2]);
             // A patch of two passes leaving both would have none of its own.
             let two = |p: &StepProfile| p.passes(h_side).len() <= 2;
             if given == [true, true] && profiles[k].as_ref().is_none_or(two) {
@@ -1097,6 +1105,8 @@ pub fn draft_with(
             };
             (lo.min(hi), lo.max(hi))
         };
+        // Where the last pass ends (its running parameter).
+        let mut t_end = 0.0;
         for (li, &w) in ws.iter().enumerate() {
             let limits = ChordLimits {
                 contact: CHORD_MARGIN * opts.chordal_mm,
@@ -1109,6 +1119,7 @@ pub fn draft_with(
                 steps.reverse();
             }
             let ts: Vec<f64> = steps.iter().map(|s| s.0).collect();
+            t_end = ts.last().copied().unwrap_or(t_end);
             let (w0, w1) = strip(li);
             for (j, &(t, cc, n)) in steps.iter().enumerate() {
                 let (pu, pv) = at(dir, t, w);
@@ -1139,7 +1150,14 @@ pub fn draft_with(
                         if k == 0 || tr.retract_before {
                             out.approach(&p, line, fp);
                         } else {
-                            // Transit from the previous patch's finishing corner.
+                            // Transit from the previous patch's finishing corner: along
+                            // the side to the first pass where the pass on the seam is a
+                            // neighbour's.
+                            if ends[0] != w {
+                                link_between(
+                                    view, dir, &mut out, ends[0], w, t, opts, r, patch, line,
+                                )?;
+                            }
                             out.link(&p, line, fp);
                         }
                     } else {
@@ -1154,6 +1172,24 @@ pub fn draft_with(
             if !progress(frac) {
                 return Err(Error::Cancelled);
             }
+        }
+        // Where the pass on the finishing seam is a neighbour's, along the side to the
+        // finishing corner, where the next patch's transit starts.
+        let last = nlines - 1;
+        if ends[1] != ws[last] && transits.get(k + 1).is_some_and(|n| !n.retract_before) {
+            let line = last as u32;
+            link_between(
+                view, dir, &mut out, ws[last], ends[1], t_end, opts, r, patch, line,
+            )?;
+            let (cc, normal) = pass_point(view, dir, t_end, ends[1])?;
+            let (pu, pv) = at(dir, t_end, ends[1]);
+            let corner = SurfacePoint {
+                patch,
+                uv: [pu, pv],
+                cc,
+                normal,
+            };
+            out.link(&corner, line, Footprint::NONE);
         }
         runs.push(PatchRun {
             patch: tr.patch as u32,

@@ -52,14 +52,18 @@ pub const STRIP_SIDE_STEPS: f64 = 4.0;
 /// Samples along a seam for the normals on its two sides.
 const SEAM_SAMPLES: usize = 16;
 /// A pass on a seam serves the rectangles on both sides when the balls on it set by the
-/// two sides' normals stand at most this share of the scallop height apart (on the .tsm
-/// models, smooth seams give 1e-15 mm, creases from 0.017 mm for r 0.5 mm).
-const SEAM_BALL_SHARE: f64 = 0.1;
+/// two sides' normals stand at most this share of the scallop height apart: the cusp
+/// beside the seam is then at most that much higher than the side step was made for.
+/// Smooth seams give 1e-15 mm, seams next to an extraordinary point's patches up to
+/// 0.0025 h (bumps-hole, r 1, h 0.05 mm: 1.3e-4 mm), creases 0.017 mm and more (the .tsm
+/// models at r 0.5 mm: 0.35 h at h 0.05 mm).
+pub const SEAM_BALL_SHARE: f64 = 0.01;
 /// Samples per side of a rectangle for its area.
 const AREA_SAMPLES: usize = 16;
 
 /// The domain cut into rectangles, ready to plan: the rectangles, their layout, their
-/// sides on the surface and the crossfeed each is cut with.
+/// sides on the surface, the crossfeed each is cut with and the seams whose passes their
+/// neighbours cut.
 struct Cut {
     rects: Vec<ChartRect>,
     layout: PatchLayout,
