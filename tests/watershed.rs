@@ -36,6 +36,19 @@ fn sides_mm(view: &isoparametric::PatchView) -> [f64; 2] {
     })
 }
 
+/// The cut of `planned` (from `m` with `o`) simulated from 200 000 samples up, until the
+/// error bound is a quarter of the scallop.
+fn simulated(m: &Model, planned: &plan::Planned, o: &PlanOptions) -> verify::Verification {
+    verify::verify_plan(
+        m,
+        planned,
+        o,
+        Some(200_000),
+        verify::PLAN_VERIFY_MAX_SAMPLES,
+    )
+    .unwrap()
+}
+
 fn reversals(m: &Model, o: &PlanOptions) -> usize {
     plan::plan(m, o, &mut |_| true).unwrap().report(o).reversals
 }
@@ -51,14 +64,7 @@ fn watershed_and_multi_rectangle_plans_keep_the_scallop_without_gouges() {
             let o = opts(strategy);
             let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
             let mut report = planned.report(&o);
-            let v = verify::verify_plan(
-                &m,
-                &planned,
-                &o,
-                Some(200_000),
-                verify::PLAN_VERIFY_MAX_SAMPLES,
-            )
-            .unwrap();
+            let v = simulated(&m, &planned, &o);
             report.add_verification(&v);
             let rects = report.rectangles.clone().unwrap();
             println!(
@@ -506,14 +512,7 @@ fn passes_past_an_extraordinary_point_keep_the_scallop() {
     let mut o = opts(Strategy::Isoparametric);
     o.crossfeed = Some(Crossfeed::U);
     let planned = plan::plan(&cut, &o, &mut |_| true).unwrap();
-    let v = verify::verify_plan(
-        &cut,
-        &planned,
-        &o,
-        Some(200_000),
-        verify::PLAN_VERIFY_MAX_SAMPLES,
-    )
-    .unwrap();
+    let v = simulated(&cut, &planned, &o);
     println!(
         "bumps-hole in four rectangles: max scallop {:.4} mm (bound {:.4} mm) at {:?}",
         v.max_scallop_mm, v.error_bound_mm, v.max_scallop_at_mm
@@ -691,14 +690,7 @@ fn transits_past_a_shared_seam_follow_the_side() {
     let m = public_tsm("face.tsm");
     let o = opts(Strategy::Watershed);
     let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
-    let v = verify::verify_plan(
-        &m,
-        &planned,
-        &o,
-        Some(200_000),
-        verify::PLAN_VERIFY_MAX_SAMPLES,
-    )
-    .unwrap();
+    let v = simulated(&m, &planned, &o);
     println!(
         "face.tsm watershed: max gouge {:.4} mm at {:?} (tolerance {:.4} mm, bound {:.4} mm), {} samples beyond",
         v.max_gouge_mm, v.max_gouge_at_mm, v.gouge_tolerance_mm, v.gouge_error_bound_mm, v.gouge_count
