@@ -1008,6 +1008,11 @@ pub fn draft_with(
     } else {
         views.iter().map(|_| None).collect()
     };
+    // Each patch's pass count at the scallop asked, where its profile is made already.
+    let natural: Vec<Option<usize>> = profiles
+        .iter()
+        .map(|p| p.as_ref().map(|p| p.passes(h_side).len()))
+        .collect();
     // Per patch, the boundary passes left to neighbours (at across-parameter 0 and 1).
     let left_out: Vec<[bool; 2]> = (0..np)
         .map(|k| {
@@ -1017,8 +1022,7 @@ pub fn draft_with(
                 .filter(|_| strict)
                 .unwrap_or([false; 2]);
             // A patch of two passes leaving both would have none of its own.
-            let two = |p: &StepProfile| p.passes(h_side).len() <= 2;
-            if given == [true, true] && profiles[k].as_ref().is_none_or(two) {
+            if given == [true, true] && natural[k].is_none_or(|n| n <= 2) {
                 [true, false]
             } else {
                 given
@@ -1027,11 +1031,10 @@ pub fn draft_with(
         .collect();
     let dropped = |k: usize| left_out[k].iter().filter(|&&x| x).count();
     let natural_odd: Option<Vec<bool>> = strict.then(|| {
-        profiles
+        natural
             .iter()
-            .flatten()
             .enumerate()
-            .map(|(k, p)| (p.passes(h_side).len() - dropped(k)) % 2 == 1)
+            .filter_map(|(k, n)| Some((n.as_ref()? - dropped(k)) % 2 == 1))
             .collect()
     });
     let (transits, forced) = corners::select(
@@ -1105,8 +1108,6 @@ pub fn draft_with(
             };
             (lo.min(hi), lo.max(hi))
         };
-        // Where the last pass ends (its running parameter).
-        let mut t_end = 0.0;
         for (li, &w) in ws.iter().enumerate() {
             let limits = ChordLimits {
                 contact: CHORD_MARGIN * opts.chordal_mm,
@@ -1119,7 +1120,6 @@ pub fn draft_with(
                 steps.reverse();
             }
             let ts: Vec<f64> = steps.iter().map(|s| s.0).collect();
-            t_end = ts.last().copied().unwrap_or(t_end);
             let (w0, w1) = strip(li);
             for (j, &(t, cc, n)) in steps.iter().enumerate() {
                 let (pu, pv) = at(dir, t, w);
@@ -1178,17 +1178,16 @@ pub fn draft_with(
         let last = nlines - 1;
         if ends[1] != ws[last] && transits.get(k + 1).is_some_and(|n| !n.retract_before) {
             let line = last as u32;
+            // The last pass runs towards t = 1 unless the zig-zag turned it round.
+            let t_end = if (last % 2 == 1) != (t_start == 1) {
+                0.0
+            } else {
+                1.0
+            };
             link_between(
                 view, dir, &mut out, ws[last], ends[1], t_end, opts, r, patch, line,
             )?;
-            let (cc, normal) = pass_point(view, dir, t_end, ends[1])?;
-            let (pu, pv) = at(dir, t_end, ends[1]);
-            let corner = SurfacePoint {
-                patch,
-                uv: [pu, pv],
-                cc,
-                normal,
-            };
+            let corner = surface_point(view, dir, t_end, ends[1], patch)?;
             out.link(&corner, line, Footprint::NONE);
         }
         runs.push(PatchRun {
@@ -1251,17 +1250,31 @@ fn link_between(
         inner.reverse();
     }
     for w in inner {
-        let (cc, n) = pass_point(s, other, w, t)?;
-        let (u, v) = at(other, w, t);
-        let p = SurfacePoint {
-            patch,
-            uv: [u, v],
-            cc,
-            normal: n,
-        };
-        out.link(&p, line, Footprint::NONE);
+        out.link(
+            &surface_point(s, other, w, t, patch)?,
+            line,
+            Footprint::NONE,
+        );
     }
     Ok(())
+}
+
+/// The point of patch `patch` at `t` along the pass at `w` (contact point and normal).
+fn surface_point(
+    s: &dyn ParamSurface,
+    dir: FeedDir,
+    t: f64,
+    w: f64,
+    patch: u32,
+) -> Result<SurfacePoint> {
+    let (cc, normal) = pass_point(s, dir, t, w)?;
+    let (u, v) = at(dir, t, w);
+    Ok(SurfacePoint {
+        patch,
+        uv: [u, v],
+        cc,
+        normal,
+    })
 }
 
 /// The planned tool path alone (see [`plan`]).

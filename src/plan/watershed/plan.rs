@@ -62,17 +62,13 @@ pub const SEAM_BALL_SHARE: f64 = 0.01;
 const AREA_SAMPLES: usize = 16;
 
 /// The domain cut into rectangles, ready to plan: the rectangles, their layout, their
-/// sides on the surface, the crossfeed each is cut with and the seams whose passes their
-/// neighbours cut.
+/// sides on the surface and the crossfeed each is cut with.
 struct Cut {
     rects: Vec<ChartRect>,
     layout: PatchLayout,
     /// Per rectangle, `[along u, along v]` (mm, [`isoparametric::side_lengths_mm`]).
     sides_mm: Vec<[f64; 2]>,
     crossfeeds: Vec<Crossfeed>,
-    /// Per rectangle, whether its boundary pass at across-parameter 0 and 1 is left to a
-    /// neighbour ([`rects::shared_seams`]).
-    seams: Vec<[bool; 2]>,
 }
 
 impl Cut {
@@ -121,7 +117,19 @@ impl Cut {
                 vec![c; own.len()]
             }
         };
-        let along_s: Vec<bool> = crossfeeds.iter().map(|&c| c == Crossfeed::V).collect();
+        Ok(Cut {
+            rects,
+            layout,
+            sides_mm,
+            crossfeeds,
+        })
+    }
+
+    /// Per rectangle, whether its boundary pass at across-parameter 0 and 1 is left to a
+    /// neighbour ([`rects::shared_seams`]); `tol` is the chart's line tolerance.
+    fn seams(&self, model: &Model, opts: &PlanOptions, tol: f64) -> Vec<[bool; 2]> {
+        let rect_charts: Vec<[f64; 4]> = self.rects.iter().map(|r| r.chart).collect();
+        let along_s: Vec<bool> = self.crossfeeds.iter().map(|&c| c == Crossfeed::V).collect();
         // One pass serves both sides of a seam where the surface is smooth across it: the
         // ball on the seam set by either side's normal is the same ball. (Across a crease
         // the two balls stand apart by r times the normals' difference.)
@@ -134,7 +142,7 @@ impl Cut {
                     let r = &rect_charts[q];
                     let (s, t) = if along_s[k] { (y, x) } else { (x, y) };
                     let (u, v) = ((s - r[0]) / (r[1] - r[0]), (t - r[2]) / (r[3] - r[2]));
-                    layout.patches[q].normal(surface, u.clamp(0.0, 1.0), v.clamp(0.0, 1.0))
+                    self.layout.patches[q].normal(surface, u.clamp(0.0, 1.0), v.clamp(0.0, 1.0))
                 });
                 match n {
                     [Some(p), Some(q)] => worst = worst.max((p - q).norm()),
@@ -143,14 +151,7 @@ impl Cut {
             }
             opts.tool_radius_mm * worst <= SEAM_BALL_SHARE * opts.scallop_mm
         };
-        let seams = rects::shared_seams(&rect_charts, &along_s, chart.line_tol(), &smooth);
-        Ok(Cut {
-            rects,
-            layout,
-            sides_mm,
-            crossfeeds,
-            seams,
-        })
+        rects::shared_seams(&rect_charts, &along_s, tol, &smooth)
     }
 
     /// Estimated cutting length (mm): per rectangle, passes `step` (mm) apart across it and
@@ -258,17 +259,18 @@ pub fn plan(
     };
     let (largest, rows) = (candidate(Merge::Largest)?, candidate(Merge::Rows)?);
     // (An estimate that is not a number is no better than the other.)
-    let Cut {
-        rects,
-        layout,
-        crossfeeds,
-        seams,
-        ..
-    } = if rows.estimated_path_mm(step) < largest.estimated_path_mm(step) {
+    let chosen = if rows.estimated_path_mm(step) < largest.estimated_path_mm(step) {
         rows
     } else {
         largest
     };
+    let seams = chosen.seams(model, opts, chart.line_tol());
+    let Cut {
+        rects,
+        layout,
+        crossfeeds,
+        ..
+    } = chosen;
     let cut = model.with_layout(layout);
     let name = if with_features {
         "watershed"
