@@ -98,6 +98,16 @@ pub fn plan_with(
     })
 }
 
+/// An area in mm² for a message: two decimals from 1 mm² up, else three significant digits
+/// (a rest area of a few thousandths of a mm² read "0.00 mm²").
+fn area_text(mm2: f64) -> String {
+    if !(mm2 > 0.0) || mm2 >= 1.0 {
+        return format!("{mm2:.2}");
+    }
+    let decimals = (2.0 - mm2.log10().floor()).clamp(2.0, 12.0) as usize;
+    format!("{mm2:.decimals$}")
+}
+
 /// Runs the pipeline on `draft`. `progress` receives the fraction of this part done and
 /// returns `false` to cancel.
 pub fn finish(
@@ -496,9 +506,10 @@ impl Planned {
             r.problems.push(Problem {
                 kind: format!("rest_{}", serde_json::to_value(why).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()),
                 message: format!(
-                    "{area:.2} mm² of the surface ({points} cut points, {} region(s); the largest {:.2} mm² around ({:.2}, {:.2}, {:.2}) mm on patch {}) {what}: {}; {advice}",
+                    "{} mm² of the surface ({points} cut points, {} region(s); the largest {} mm² around ({:.2}, {:.2}, {:.2}) mm on patch {}) {what}: {}; {advice}",
+                    area_text(area),
                     regions.len(),
-                    largest.area_mm2,
+                    area_text(largest.area_mm2),
                     c[0],
                     c[1],
                     c[2],
@@ -637,4 +648,25 @@ impl PlanReport {
 /// A length for a note: four decimals (mm).
 fn fmt_mm(mm: f64) -> String {
     format!("{mm:.4}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::area_text;
+
+    /// Small rest areas keep three significant digits; from 1 mm² up, two decimals.
+    #[test]
+    fn areas_in_messages_keep_their_digits() {
+        for (mm2, text) in [
+            (0.0, "0.00"),
+            (0.000412, "0.000412"),
+            (0.0031, "0.00310"),
+            (0.95, "0.950"),
+            (1.0, "1.00"),
+            (12.3456, "12.35"),
+            (663.31, "663.31"),
+        ] {
+            assert_eq!(area_text(mm2), text);
+        }
+    }
 }
