@@ -98,14 +98,24 @@ pub fn plan_with(
     })
 }
 
-/// An area in mm² for a message: two decimals from 1 mm² up, else three significant digits
-/// (a rest area of a few thousandths of a mm² read "0.00 mm²").
+/// Significant digits of an area under 1 mm² in a message.
+const AREA_DIGITS: i32 = 3;
+
+/// An area in mm² for a message: two decimals from 1 mm² up, else [`AREA_DIGITS`]
+/// significant digits (a rest area of a few thousandths of a mm² read "0.00 mm²").
 fn area_text(mm2: f64) -> String {
+    let decimals = |x: f64| (AREA_DIGITS - 1 - x.log10().floor() as i32).max(2);
     if !(mm2 > 0.0) || mm2 >= 1.0 {
         return format!("{mm2:.2}");
     }
-    let decimals = (2.0 - mm2.log10().floor()).clamp(2.0, 12.0) as usize;
-    format!("{mm2:.decimals$}")
+    // The digits of the value as rounded (0.9996 is "1.00", 0.0099996 "0.0100").
+    let scale = 10f64.powi(decimals(mm2));
+    let rounded = (mm2 * scale).round() / scale;
+    if rounded >= 1.0 {
+        return format!("{rounded:.2}");
+    }
+    let d = decimals(rounded) as usize;
+    format!("{rounded:.d$}")
 }
 
 /// Runs the pipeline on `draft`. `progress` receives the fraction of this part done and
@@ -665,6 +675,8 @@ mod tests {
             (1.0, "1.00"),
             (12.3456, "12.35"),
             (663.31, "663.31"),
+            (0.9996, "1.00"),
+            (0.0099996, "0.0100"),
         ] {
             assert_eq!(area_text(mm2), text);
         }

@@ -37,7 +37,8 @@ pub struct GougeStats {
     pub residual: usize,
     pub residual_mm: f64,
     /// Cut points added between two cut points where the ball, moving straight from one to
-    /// the other, cut into the surface (a fold or crease between them); they are lifted too.
+    /// the other, cut into the surface (a fold or crease between them); those that cut in
+    /// themselves are lifted too.
     pub inserted: usize,
 }
 
@@ -90,9 +91,12 @@ const TIGHT_MARGIN: f64 = 0.25;
 /// cuts into the surface by more than `tol` mm, until it is a radius from the nearest surface point (within `tol`).
 /// The contact point becomes that nearest point; `left[i]` becomes the material the lifted
 /// ball leaves at move `i`'s old contact point (mm; untouched for moves not lifted).
-/// Then the straight moves next to lifted points, and those over which the ball turns round
-/// a convex crease, are checked between their ends: where the ball cuts in on the way, a
-/// lifted cut point is added half-way (and the halves checked again, [`SEGMENT_HALVINGS`] deep). Returns what it did and, when points were added, for
+/// Then the straight moves next to lifted points, those over which the ball turns round a
+/// convex crease, and those that cut into a surface point they know of (their ends' contacts,
+/// crease points where they pass from one face to another; [`WITNESS_DEPTH`]) are checked
+/// between their ends: where the ball cuts in on the way, a lifted cut point is added
+/// half-way, or where it cuts such a point deepest (and the pieces checked again,
+/// [`SEGMENT_HALVINGS`] deep). Returns what it did and, when points were added, for
 /// every move of the new path the old move it is (`u32::MAX` for added ones; empty when
 /// nothing was added). `keep_going` is told every few hundred moves the share of the work
 /// done (0 to 1: the lifting pass to one half, the straight moves to the whole); false
@@ -185,15 +189,23 @@ pub fn lift(
         // Points of the surface the move must stay a radius from: its ends' contacts (a
         // ball leaving a convex crease, its contact on the crease line and its centre set by
         // one side's normal, cuts the crease on its way to a point well along the other
-        // side), and where it passes from one face to another, in case a crease runs there
-        // (neither the ends' normals nor their contacts tell a crease between them).
+        // side), and the crease points where it passes from one face to another (a crease
+        // between its ends, or just past one, which its ends' normals do not tell: the
+        // cuts into face.tsm were found there).
         witnesses.clear();
         witnesses.extend([a.cc_point, b.cc_point]);
-        if creased && a.patch == b.patch && b.kind.on_surface() {
+        if creased && a.patch == b.patch {
             if let Some(patch) = model.layout.patches.get(a.patch as usize) {
-                let face = |q: [f64; 2]| patch.face_param(&model.surface, q[0], q[1]).0;
-                face_changes(&face, (pa, face(pa)), (pb, face(pb)), &mut |q| {
-                    witnesses.push(patch.subs(&model.surface, q[0], q[1]))
+                let surface = &model.surface;
+                let face = |q: [f64; 2]| patch.face_param(surface, q[0], q[1]).0;
+                face_changes(&face, (pa, face(pa)), (pb, face(pb)), &mut |x, y| {
+                    let normal = |q: [f64; 2]| patch.normal(surface, q[0], q[1]);
+                    if let (Some(nx), Some(ny)) = (normal(x), normal(y)) {
+                        if nx.angle(&ny) > CREASE_TURN_RAD {
+                            let q = [0.5 * (x[0] + y[0]), 0.5 * (x[1] + y[1])];
+                            witnesses.push(patch.subs(surface, q[0], q[1]));
+                        }
+                    }
                 });
             }
         }
@@ -201,7 +213,7 @@ pub fn lift(
         // on an arc round the crease, the straight move cuts the chord of that arc.
         let turn = (a.cl_point - a.cc_point).angle(&(b.cl_point - b.cc_point));
         let pivots = r * (1.0 - (0.5 * turn).cos()) > tol;
-        let cuts_in = cuts_witness(a, b, &witnesses, r, WITNESS_DEPTH * tol);
+        let cuts_in = witness_cut(a, b, &witnesses, r, WITNESS_DEPTH * tol).is_some();
         if !(pivots || near_lifted(i) || cuts_in) {
             continue;
         }
@@ -243,60 +255,79 @@ pub const SEGMENT_HALVINGS: usize = 6;
 /// Where between its ends a straight move is checked (fractions of it).
 const SEGMENT_PROBES: [f64; 3] = [0.5, 0.25, 0.75];
 
-/// Whether the ball moving straight from `a` to `b` comes nearer than `r - tol` to any of
-/// `witnesses`, points of the surface: a cut found for certain, wherever the rest of the
-/// surface lies (face.tsm's watershed plan at r 0.5 mm: 0.0029 mm into a crease, 0.06 of
-/// the way along a 0.95 mm move leaving it, and 0.0021 mm 0.64 of the way along a 0.45 mm
-/// move across one; the end normals turned too little for the pivot estimate).
-fn cuts_witness(a: &Move, b: &Move, witnesses: &[Point3], r: f64, tol: f64) -> bool {
+/// Where the ball moving straight from `a` to `b` cuts deepest, by more than `depth`, into
+/// one of `witnesses`, points of the surface (a cut found for certain, wherever the rest of
+/// the surface lies): the share of the way along, if it does. A witness either end's ball
+/// already cuts is left to the lifting of that end (the move cannot clear it). face.tsm's
+/// watershed plan at r 0.5 mm cut 0.0029 mm into a crease 0.06 of the way along a 0.95 mm
+/// move starting just before it, and 0.0021 mm 0.64 of the way along a 0.45 mm move across
+/// one; the end normals turned too little for the pivot estimate.
+fn witness_cut(a: &Move, b: &Move, witnesses: &[Point3], r: f64, depth: f64) -> Option<f64> {
     let d = b.cl_point - a.cl_point;
     let len2 = d.norm_squared();
-    witnesses.iter().any(|q| {
+    let near = r - depth;
+    let mut deepest: Option<(f64, f64)> = None;
+    for q in witnesses {
+        if (a.cl_point - q).norm() < near || (b.cl_point - q).norm() < near {
+            continue;
+        }
         let s = if len2 > 0.0 {
             ((q - a.cl_point).dot(&d) / len2).clamp(0.0, 1.0)
         } else {
             0.0
         };
-        (a.cl_point + d * s - q).norm() < r - tol
-    })
+        let gap = (a.cl_point + d * s - q).norm();
+        if gap < near && deepest.is_none_or(|(g, _)| gap < g) {
+            deepest = Some((gap, s));
+        }
+    }
+    deepest.map(|(_, s)| s)
 }
 
-/// How deep a move must cut into one of its witnesses (its ends' contacts, where it passes
-/// from one face to another) to be split, as a multiple of the lifting tolerance; once split,
-/// its pieces are split until none cuts a witness deeper than the tolerance. The pipeline's
-/// tolerance is a fifth of the overcut limit, the rest left to the straight moves: four
+/// Least turn of the normal across a face change for it to count as a crease (rad): a kink
+/// turning less cuts a move of length L at most about L times a quarter of the turn deep
+/// (0.0001 mm for a 4 mm move).
+const CREASE_TURN_RAD: f64 = 1e-4;
+
+/// How deep a move must cut into one of its witnesses (its ends' contacts, crease points
+/// where it passes from one face to another) to be split, as a multiple of the lifting
+/// tolerance; once split, the pieces are split further (up to [`SEGMENT_HALVINGS`] deep)
+/// where they cut one deeper than the tolerance. The pipeline's lifting tolerance is a fifth
+/// of the overcut limit (`GOUGE_LIFT_SHARE`), the rest left to the straight moves: four
 /// fifths. Splitting every move that cut a witness deeper than the tolerance took face.tsm's
 /// plan (r 0.5 mm, h 0.01 mm) from 572 to 735 ms and added 2 900 cut points, for cuts the
-/// simulation had passed; at four fifths, 589 ms and 345 points.
+/// simulation had passed.
 const WITNESS_DEPTH: f64 = 4.0;
 
 /// Halvings of a move's parameter segment while looking for where it passes from one face to
 /// another (the place is found to 2^-20 of the segment).
 const FACE_CHANGE_HALVINGS: usize = 20;
 
-/// Calls `found` with the parameters where the segment from `a` to `b` (each with its face)
-/// passes from one face to another: every change between faces the halving meets.
+/// Calls `found` with the parameters either side of each place where the segment from `a`
+/// to `b` (each with its face) passes from one face to another, 2^-20 of the segment apart:
+/// every change between faces the halving meets (the faces are rectangles in the patch's
+/// parameters, so the segment passes through each once).
 fn face_changes(
     face: &dyn Fn([f64; 2]) -> u32,
     a: ([f64; 2], u32),
     b: ([f64; 2], u32),
-    found: &mut dyn FnMut([f64; 2]),
+    found: &mut dyn FnMut([f64; 2], [f64; 2]),
 ) {
     fn halve(
         face: &dyn Fn([f64; 2]) -> u32,
         (a, fa): ([f64; 2], u32),
         (b, fb): ([f64; 2], u32),
         depth: usize,
-        found: &mut dyn FnMut([f64; 2]),
+        found: &mut dyn FnMut([f64; 2], [f64; 2]),
     ) {
         if fa == fb {
             return;
         }
-        let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
         if depth == 0 {
-            found(m);
+            found(a, b);
             return;
         }
+        let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
         let fm = face(m);
         halve(face, (a, fa), (m, fm), depth - 1, found);
         halve(face, (m, fm), (b, fb), depth - 1, found);
@@ -451,8 +482,10 @@ fn step_clear_of_both(
     }
 }
 
-/// Adds to `out`, in order from `a` to `b`, lifted cut points where the ball moving straight
-/// from `a` to `b` cuts in by more than `tol`, checking the halves again up to `depth` deep.
+/// Adds to `out`, in order from `a` to `b`, cut points where the ball moving straight from
+/// `a` to `b` cuts in by more than `tol` (half-way where a probe finds it, else where it cuts
+/// one of `witnesses` deepest), lifted clear where they cut in themselves, checking the
+/// pieces again up to `depth` deep.
 #[allow(clippy::too_many_arguments)]
 fn split_segment(
     near: &Nearest,
@@ -473,28 +506,32 @@ fn split_segment(
     // The first probe is the middle, whose nearest point the lifting starts from.
     let middle = probe(SEGMENT_PROBES[0]);
     let cuts_in = |x: Option<(f64, Point3)>| x.is_some_and(|(d, _)| d < r - tol);
-    if !(cuts_in(middle)
-        || SEGMENT_PROBES[1..].iter().any(|&s| cuts_in(probe(s)))
-        || cuts_witness(ma, mb, witnesses, r, tol))
-    {
+    // Split half-way where a probe cuts in, else where the move cuts a witness deepest.
+    let (s, first) = if cuts_in(middle) || SEGMENT_PROBES[1..].iter().any(|&s| cuts_in(probe(s))) {
+        (SEGMENT_PROBES[0], middle)
+    } else if let Some(s) = witness_cut(ma, mb, witnesses, r, tol) {
+        (s, probe(s))
+    } else {
         return;
-    }
-    let mid = at(SEGMENT_PROBES[0]);
-    let away = (ma.cl_point - ma.cc_point) + (mb.cl_point - mb.cc_point);
-    let (centre, contact, clear) = match middle
-        .and_then(|first| lift_one(near, mid, first, r, tol, hints, None, away, stats))
-    {
-        Some(l) => (l.centre, l.contact, l.clear),
-        None => (mid, middle.map_or(ma.cc_point, |(_, q)| q), true),
     };
-    let q = [0.5 * (a.1[0] + b.1[0]), 0.5 * (a.1[1] + b.1[1])];
+    let c = at(s);
+    let away = (ma.cl_point - ma.cc_point) + (mb.cl_point - mb.cc_point);
+    let (centre, contact, clear) =
+        match first.and_then(|first| lift_one(near, c, first, r, tol, hints, None, away, stats)) {
+            Some(l) => (l.centre, l.contact, l.clear),
+            None => (c, first.map_or(ma.cc_point, |(_, q)| q), true),
+        };
+    let q = [
+        a.1[0] + s * (b.1[0] - a.1[0]),
+        a.1[1] + s * (b.1[1] - a.1[1]),
+    ];
     let m = Move {
         cl_point: centre,
         cc_point: contact,
         ..*mb
     };
-    // Where the ball cannot be put clear half-way, points nearer either end would not clear
-    // the move through the middle either (the residual is reported).
+    // Where the ball cannot be put clear at the split, points nearer either end would not
+    // clear the move through it either (the residual is reported).
     let depth = if clear { depth - 1 } else { 0 };
     let known = (hints, witnesses);
     split_segment(near, a, (&m, q), (r, tol), known, depth, stats, out);
@@ -538,13 +575,16 @@ mod tests {
             assert!(depth > 0.0);
             for tol in [0.5 * depth, 0.9 * depth] {
                 assert!(
-                    cuts_witness(&a, &b, &[crease], r, tol),
+                    witness_cut(&a, &b, &[crease], r, tol).is_some(),
                     "{angle} {s} {depth}"
                 );
             }
+            // A witness an end's ball cuts is left to that end.
+            let inside = Point3::new(0.0, 0.0, 0.5 * r);
+            assert!(witness_cut(&a, &b, &[inside], r, 0.5 * depth).is_none());
             for tol in [1.1 * depth, 2.0 * depth] {
                 assert!(
-                    !cuts_witness(&a, &b, &[crease], r, tol),
+                    witness_cut(&a, &b, &[crease], r, tol).is_none(),
                     "{angle} {s} {depth}"
                 );
             }
@@ -567,17 +607,24 @@ mod tests {
         };
         let (a, b) = ([0.1, 0.3], [0.9, 0.7]);
         let mut found = Vec::new();
-        face_changes(&face, (a, face(a)), (b, face(b)), &mut |q| found.push(q));
+        face_changes(&face, (a, face(a)), (b, face(b)), &mut |x, y| {
+            found.push((x, y))
+        });
         assert_eq!(found.len(), 2, "{found:?}");
-        for (q, u) in found.iter().zip([0.25, 0.6]) {
-            assert!((q[0] - u).abs() <= 0.8 * 2f64.powi(-20), "{q:?}");
-            // On the segment.
-            let t = (q[0] - a[0]) / (b[0] - a[0]);
-            assert!((q[1] - (a[1] + t * (b[1] - a[1]))).abs() < 1e-12);
+        let t = |q: [f64; 2]| (q[0] - a[0]) / (b[0] - a[0]);
+        for ((x, y), u) in found.iter().zip([0.25, 0.6]) {
+            // Either side of the change, 2^-20 of the segment apart, on the segment.
+            assert!(x[0] < u && u <= y[0], "{x:?} {y:?}");
+            assert!((t(*y) - t(*x) - 2f64.powi(-20)).abs() < 1e-15);
+            for q in [x, y] {
+                assert!((q[1] - (a[1] + t(*q) * (b[1] - a[1]))).abs() < 1e-12);
+            }
         }
         let mut none = Vec::new();
         let c = [0.3, 0.1];
-        face_changes(&face, (c, face(c)), ([0.5, 0.9], 1), &mut |q| none.push(q));
+        face_changes(&face, (c, face(c)), ([0.5, 0.9], 1), &mut |x, _| {
+            none.push(x)
+        });
         assert!(none.is_empty());
     }
 
