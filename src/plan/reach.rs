@@ -268,16 +268,29 @@ pub fn unsplit_params(path: &Toolpath, origin: &[u32], n: usize) -> Vec<[f64; 2]
 }
 
 /// The runs of the draft over the split path: each keeps the moves it had that were kept;
-/// a run with none is dropped (its patch is all rest area).
+/// a run with none is dropped (its patch is all rest area). The runs follow one another
+/// along the draft, so one walk over the split path finds each run's first and last kept
+/// move (a search per run from the start of the path took runs × moves: the iso-planar
+/// strategy's hundreds of runs on paths of tens of thousands of moves).
 fn split_runs(runs: &[PatchRun], moves: &[Move], origin: &[u32]) -> Vec<PatchRun> {
+    debug_assert!(runs.windows(2).all(|w| w[0].last_move < w[1].first_move));
+    // First and last kept move of each run.
+    let mut kept: Vec<Option<(usize, usize)>> = vec![None; runs.len()];
+    for (k, &o) in origin.iter().enumerate().take(moves.len()) {
+        if o == u32::MAX {
+            continue;
+        }
+        let o = o as usize;
+        let j = runs.partition_point(|r| r.last_move < o);
+        if runs.get(j).is_some_and(|r| r.first_move <= o) {
+            let span = kept[j].get_or_insert((k, k));
+            span.1 = k;
+        }
+    }
     runs.iter()
-        .filter_map(|run| {
-            let within = |k: usize| {
-                let o = origin[k];
-                o != u32::MAX && (run.first_move..=run.last_move).contains(&(o as usize))
-            };
-            let first = (0..moves.len()).find(|&k| within(k))?;
-            let last = (first..moves.len()).rev().find(|&k| within(k))?;
+        .zip(kept)
+        .filter_map(|(run, kept)| {
+            let (first, last) = kept?;
             // The air moves before a run's first cut belong to it, as in the draft.
             let mut start = first;
             while start > 0 && !moves[start - 1].kind.on_surface() && origin[start - 1] == u32::MAX
