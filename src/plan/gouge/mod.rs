@@ -194,11 +194,14 @@ pub fn lift(
         // cuts into face.tsm were found there).
         witnesses.clear();
         witnesses.extend([a.cc_point, b.cc_point]);
-        if creased && a.patch == b.patch {
+        // The ends' faces: read for every move where the surface may crease (the face
+        // changes start from them), else only for a move that is split.
+        let ends = creased.then(|| (hint(a, pa), hint(b, pb)));
+        if let Some((Some((fa, _)), Some((fb, _)))) = ends.filter(|_| a.patch == b.patch) {
             if let Some(patch) = model.layout.patches.get(a.patch as usize) {
                 let surface = &model.surface;
                 let face = |q: [f64; 2]| patch.face_param(surface, q[0], q[1]).0;
-                face_changes(&face, (pa, face(pa)), (pb, face(pb)), &mut |x, y| {
+                face_changes(&face, (pa, fa), (pb, fb), &mut |x, y| {
                     let normal = |q: [f64; 2]| patch.normal(surface, q[0], q[1]);
                     if let (Some(nx), Some(ny)) = (normal(x), normal(y)) {
                         if nx.angle(&ny) > CREASE_TURN_RAD {
@@ -218,8 +221,8 @@ pub fn lift(
             continue;
         }
         let mut out = Vec::new();
-        let hints: Vec<(u32, [f64; 2])> =
-            [hint(a, pa), hint(b, pb)].into_iter().flatten().collect();
+        let (ha, hb) = ends.unwrap_or_else(|| (hint(a, pa), hint(b, pb)));
+        let hints: Vec<(u32, [f64; 2])> = [ha, hb].into_iter().flatten().collect();
         split_segment(
             &near,
             (a, pa),
@@ -582,6 +585,9 @@ mod tests {
             // A witness an end's ball cuts is left to that end.
             let inside = Point3::new(0.0, 0.0, 0.5 * r);
             assert!(witness_cut(&a, &b, &[inside], r, 0.5 * depth).is_none());
+            // One on the move's line past its end is as far as from that end.
+            let past = b.cl_point + (b.cl_point - a.cl_point).normalize() * (1.5 * r);
+            assert!(witness_cut(&a, &b, &[past], r, 0.5 * depth).is_none());
             for tol in [1.1 * depth, 2.0 * depth] {
                 assert!(
                     witness_cut(&a, &b, &[crease], r, tol).is_none(),
@@ -620,12 +626,57 @@ mod tests {
                 assert!((q[1] - (a[1] + t(*q) * (b[1] - a[1]))).abs() < 1e-12);
             }
         }
-        let mut none = Vec::new();
-        let c = [0.3, 0.1];
-        face_changes(&face, (c, face(c)), ([0.5, 0.9], 1), &mut |x, _| {
-            none.push(x)
-        });
-        assert!(none.is_empty());
+    }
+
+    /// Against a second method: on a patch of rectangular faces (knots at uneven spacing),
+    /// every change of face that sampling 20 000 points along a segment sees lies between a
+    /// pair the halving gives, and every pair brackets a change; 200 segments.
+    #[test]
+    fn face_changes_agree_with_dense_sampling() {
+        let (ku, kv) = ([0.0, 0.13, 0.3, 0.31, 0.7, 1.0], [0.0, 0.5, 0.52, 0.9, 1.0]);
+        let cell = |k: &[f64], x: f64| {
+            k[1..]
+                .iter()
+                .take_while(|&&e| e <= x)
+                .count()
+                .min(k.len() - 2)
+        };
+        let face = |q: [f64; 2]| (cell(&ku, q[0]) * 10 + cell(&kv, q[1])) as u32;
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        const SAMPLES: usize = 20_000;
+        let mut changes = 0;
+        for _ in 0..200 {
+            let (a, b) = ([next(), next()], [next(), next()]);
+            let at = |t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+            let t_of = |q: [f64; 2]| {
+                let d = [b[0] - a[0], b[1] - a[1]];
+                ((q[0] - a[0]) * d[0] + (q[1] - a[1]) * d[1]) / (d[0] * d[0] + d[1] * d[1])
+            };
+            let mut pairs = Vec::new();
+            face_changes(&face, (a, face(a)), (b, face(b)), &mut |x, y| {
+                pairs.push((t_of(x), t_of(y)))
+            });
+            for &(x, y) in &pairs {
+                assert_ne!(face(at(x)), face(at(y)));
+            }
+            for i in 1..=SAMPLES {
+                let (t0, t1) = ((i - 1) as f64 / SAMPLES as f64, i as f64 / SAMPLES as f64);
+                if face(at(t0)) != face(at(t1)) {
+                    changes += 1;
+                    assert!(
+                        pairs.iter().any(|&(x, y)| x < t1 + 1e-12 && y > t0 - 1e-12),
+                        "a change in [{t0}, {t1}] of {a:?} -> {b:?} not found: {pairs:?}"
+                    );
+                }
+            }
+        }
+        assert!(changes > 200, "{changes}");
     }
 
     /// A ball centred on the surface itself (catmark_rook.obj read in centimetres, r 0.5
