@@ -154,8 +154,7 @@ impl CapsuleIndex {
         stamp: u32,
         mut f: impl FnMut(u32),
     ) {
-        let mid = [0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)];
-        let half = 0.5 * (b - a).norm() * (1.0 + SLACK);
+        let (mid, half) = query_ball(a, b);
         let mut emit =
             |cell: usize| self.emit_near(capsules, cell, &mid, half, seen, stamp, &mut f);
         // Clip the segment to the grid's box (slabs).
@@ -282,20 +281,7 @@ impl CapsuleIndex {
     ) {
         let (s, e) = (self.starts[cell] as usize, self.starts[cell + 1] as usize);
         for &i in &self.items[s..e] {
-            let b = &self.balls[i as usize];
-            let (dx, dy, dz) = (b[0] - mid[0], b[1] - mid[1], b[2] - mid[2]);
-            let within = b[3] + half;
-            if dx * dx + dy * dy + dz * dz > within * within {
-                continue;
-            }
-            // Closer: the move's segment from the query's middle.
-            let c = &capsules[i as usize];
-            let (a, d) = (&c.start, &c.dir);
-            let (wx, wy, wz) = (mid[0] - a.x, mid[1] - a.y, mid[2] - a.z);
-            let s = (wx * d.x + wy * d.y + wz * d.z).clamp(0.0, c.len);
-            let (ex, ey, ez) = (wx - s * d.x, wy - s * d.y, wz - s * d.z);
-            let reach = self.radius_slack + half;
-            if ex * ex + ey * ey + ez * ez > reach * reach {
+            if !self.near_query(capsules, i, &self.balls[i as usize], mid, half) {
                 continue;
             }
             if seen[i as usize] != stamp {
@@ -305,10 +291,52 @@ impl CapsuleIndex {
         }
     }
 
+    /// Whether capsule `i` (its bounding ball `ball`, as [`CapsuleIndex::ball`] gives it)
+    /// may meet a query segment lying within `half` of `mid` ([`query_ball`]): first its
+    /// bounding ball, then its segment, within the radius plus `half` of `mid`. False only
+    /// for a capsule the segment cannot meet.
+    #[inline]
+    pub fn near_query(
+        &self,
+        capsules: &[Capsule],
+        i: u32,
+        ball: &[f64; 4],
+        mid: &[f64; 3],
+        half: f64,
+    ) -> bool {
+        let (dx, dy, dz) = (ball[0] - mid[0], ball[1] - mid[1], ball[2] - mid[2]);
+        let within = ball[3] + half;
+        if dx * dx + dy * dy + dz * dz > within * within {
+            return false;
+        }
+        // Closer: the move's segment from the query's middle.
+        let c = &capsules[i as usize];
+        let (a, d) = (&c.start, &c.dir);
+        let (wx, wy, wz) = (mid[0] - a.x, mid[1] - a.y, mid[2] - a.z);
+        let s = (wx * d.x + wy * d.y + wz * d.z).clamp(0.0, c.len);
+        let (ex, ey, ez) = (wx - s * d.x, wy - s * d.y, wz - s * d.z);
+        let reach = self.radius_slack + half;
+        ex * ex + ey * ey + ez * ez <= reach * reach
+    }
+
+    /// Capsule `i`'s bounding ball: its middle and a radius (mm) reaching past every point
+    /// of it, with a little slack for rounding.
+    pub fn ball(&self, i: u32) -> [f64; 4] {
+        self.balls[i as usize]
+    }
+
     /// Edge length of a cell (mm).
     pub fn cell_mm(&self) -> f64 {
         self.cell_mm
     }
+}
+
+/// The ball round a query segment from `a` to `b` that [`CapsuleIndex::near_query`] takes:
+/// its middle and half its length (mm), with a little slack for rounding.
+#[inline]
+pub fn query_ball(a: &Point3, b: &Point3) -> ([f64; 3], f64) {
+    let mid = [0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)];
+    (mid, 0.5 * (b - a).norm() * (1.0 + SLACK))
 }
 
 #[cfg(test)]

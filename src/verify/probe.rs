@@ -3,7 +3,7 @@
 //! (scallop); if the point itself was swept, the depth the cut went below it (gouge).
 
 use super::capsule::{Capsule, LineHit, Span};
-use super::index::CapsuleIndex;
+use super::index::{query_ball, CapsuleIndex};
 use crate::geom::{Point3, Vector3};
 
 /// Length of the first look along the normal, either way, in index cells.
@@ -66,6 +66,27 @@ struct Focus {
     centre: Point3,
     radius: f64,
     capsules: Vec<u32>,
+    /// Their bounding balls ([`CapsuleIndex::ball`]), side by side: a query reads them in
+    /// turn and tests only the capsules near it ([`CapsuleIndex::near_query`]).
+    balls: Vec<[f64; 4]>,
+}
+
+impl Focus {
+    /// The capsules that may meet the segment from `a` to `b`, in the focus's order.
+    fn near<'f>(
+        &'f self,
+        index: &'f CapsuleIndex,
+        capsules: &'f [Capsule],
+        a: &Point3,
+        b: &Point3,
+    ) -> impl Iterator<Item = u32> + 'f {
+        let (mid, half) = query_ball(a, b);
+        self.capsules
+            .iter()
+            .zip(&self.balls)
+            .filter(move |(&i, ball)| index.near_query(capsules, i, ball, &mid, half))
+            .map(|(&i, _)| i)
+    }
 }
 
 impl<'a> Probe<'a> {
@@ -105,8 +126,13 @@ impl<'a> Probe<'a> {
     pub fn focus(&mut self, centre: &Point3, radius: f64) {
         let g = Vector3::repeat(radius);
         let (lo, hi) = (centre - g, centre + g);
-        let mut list = self.focus.take().map(|f| f.capsules).unwrap_or_default();
+        let (mut list, mut balls) = self
+            .focus
+            .take()
+            .map(|f| (f.capsules, f.balls))
+            .unwrap_or_default();
         list.clear();
+        balls.clear();
         // Only inside the grid: outside it the index lists nothing, and the focus must find
         // what the index finds. And only a ball no wider than a cell's reach past its
         // centre: a wider one lists more capsules than a cell does (Bike.tsm's long
@@ -125,10 +151,12 @@ impl<'a> Probe<'a> {
                 }
             });
         list.sort_unstable();
+        balls.extend(list.iter().map(|&i| self.index.ball(i)));
         self.focus = Some(Focus {
             centre: *centre,
             radius,
             capsules: list,
+            balls,
         });
     }
 
@@ -151,7 +179,7 @@ impl<'a> Probe<'a> {
         let (a, b) = (p + n * lo, p + n * hi);
         let (caps, r) = (self.capsules, self.radius);
         if let (Some(f), true) = (&self.focus, self.focused(&a, &b)) {
-            for &i in &f.capsules {
+            for i in f.near(self.index, caps, &a, &b) {
                 if let Some(h) = caps[i as usize].interval(r, p, n, lo, hi) {
                     self.hits.push((i, h));
                 }
@@ -194,7 +222,7 @@ impl<'a> Probe<'a> {
         };
         match (&self.focus, focused) {
             (Some(f), true) => {
-                for &i in &f.capsules {
+                for i in f.near(self.index, caps, &a, &b) {
                     if test(i) {
                         return true;
                     }
@@ -255,14 +283,14 @@ impl<'a> Probe<'a> {
         }
         let (caps, r, reach) = (self.capsules, self.radius, self.reach);
         let mut found = false;
-        let mut test = |i: u32| {
+        let test = |i: u32| {
             found = found
                 || caps[i as usize]
                     .interval(r, p, n, near, reach)
                     .is_some_and(|h| h.t_in > 0.0);
         };
         match (&self.focus, focused) {
-            (Some(f), true) => f.capsules.iter().for_each(|&i| test(i)),
+            (Some(f), true) => f.near(self.index, caps, &a, &b).for_each(test),
             _ => self
                 .index
                 .visit(caps, &a, &b, &mut self.seen, self.stamp, test),
