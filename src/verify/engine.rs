@@ -198,6 +198,8 @@ pub fn area_mm2(surface: &Surface) -> f64 {
 fn grids(surface: &Surface, samples: usize) -> Vec<FaceGrid> {
     let sizes: Vec<(f64, f64, f64)> = surface.faces().iter().map(face_size).collect();
     let total: f64 = sizes.iter().map(|s| s.0).sum();
+    // The samples' spacing where each has its share of the area (mm).
+    let spacing = (total / samples.max(1) as f64).sqrt();
     sizes
         .iter()
         .map(|&(area, lu, lv)| {
@@ -207,11 +209,22 @@ fn grids(surface: &Surface, samples: usize) -> Vec<FaceGrid> {
                 samples as f64 / sizes.len() as f64
             };
             let aspect = if lu > 0.0 && lv > 0.0 { lu / lv } else { 1.0 };
-            // At least 2 × 2, and no more than its share even for a sliver of a patch.
+            // At least 2 × 2, and no more than its share even for a sliver of a patch...
             let most = (0.5 * share).max(2.0);
-            let nu = (share * aspect).sqrt().round().clamp(2.0, most) as usize;
-            let nv = (share / nu as f64).round().clamp(2.0, most) as usize;
-            FaceGrid { nu, nv }
+            let mut nu = (share * aspect).sqrt().round().clamp(2.0, most);
+            let mut nv = (share / nu).round().clamp(2.0, most);
+            // ...but one with a side of 2 (a sliver, or a patch smaller than a few samples'
+            // share) is sampled at least at the spacing of the rest, across and along: two
+            // samples across Bike.tsm's 0.017-0.024 mm wide watershed rectangle bounded its
+            // scallop to 0.0075 mm, where the others were bounded within 0.0015 mm.
+            if nu == 2.0 || nv == 2.0 {
+                nu = nu.max((lu / spacing).ceil() + 1.0);
+                nv = nv.max((lv / spacing).ceil() + 1.0);
+            }
+            FaceGrid {
+                nu: nu as usize,
+                nv: nv as usize,
+            }
         })
         .collect()
 }
