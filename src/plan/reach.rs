@@ -401,22 +401,21 @@ const FINE_CELLS_PER_REACH: f64 = 32.0;
 /// keep two spheres that meet out of a shared cell (dimensionless).
 const ROUNDING_WIDENING: f64 = 1e-9;
 
-/// Points listed in cells of a hash grid, for "is any of them within a distance of this
-/// move" asked of every move of a path.
-struct PointsNear<'a> {
-    points: &'a [Point3],
-    /// The distance asked about, also the cells' size (mm).
-    within: f64,
+/// Points listed in the cells of a hash grid, each in its own cell and the 26 round it: the
+/// points within a cell's size of a place are listed in that place's cell.
+struct PointGrid {
+    points: Vec<Point3>,
+    /// Edge of a cell (mm).
+    cell: f64,
     cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
 }
 
-impl<'a> PointsNear<'a> {
-    /// Lists `points` for queries within `within` mm (positive): each in its cell and the 26
-    /// round it, so a move looks only in the cells its own box meets.
-    fn new(points: &'a [Point3], within: f64) -> Self {
+impl PointGrid {
+    /// Lists `points` in cells `cell` mm wide (positive).
+    fn new(points: Vec<Point3>, cell: f64) -> Self {
         let mut cells: std::collections::HashMap<[i64; 3], Vec<u32>> = Default::default();
         for (k, p) in points.iter().enumerate() {
-            let c = Self::key(p, within);
+            let c = Self::key(p, cell);
             for dx in -1..=1 {
                 for dy in -1..=1 {
                     for dz in -1..=1 {
@@ -428,9 +427,9 @@ impl<'a> PointsNear<'a> {
                 }
             }
         }
-        PointsNear {
+        PointGrid {
             points,
-            within,
+            cell,
             cells,
         }
     }
@@ -439,22 +438,40 @@ impl<'a> PointsNear<'a> {
         [p.x, p.y, p.z].map(|x| (x / cell).floor() as i64)
     }
 
-    /// Whether a point lies within the distance of the segment of move `c`: a point within
-    /// it of a point of the segment lies in that point's cell or one round it.
-    fn any_within(&self, c: &Capsule) -> bool {
+    /// The point with index `k`.
+    fn point(&self, k: u32) -> &Point3 {
+        &self.points[k as usize]
+    }
+
+    /// The points listed in the cell of `p` (every one within a cell's size of it, and
+    /// others up to two cells away), by index.
+    fn listed(&self, p: &Point3) -> &[u32] {
+        self.cells
+            .get(&Self::key(p, self.cell))
+            .map_or(&[], Vec::as_slice)
+    }
+
+    /// Whether a point lies within `within` mm (at most a cell's size) of the segment of move
+    /// `c`: one within it of a point of the segment is listed in that point's cell, which
+    /// lies in the segment's box; where that box spans more cells than there are points,
+    /// each point is tested instead.
+    fn any_within(&self, c: &Capsule, within: f64) -> bool {
         let (a, b) = (c.start, c.end());
-        let lo = Self::key(&a.inf(&b), self.within);
-        let hi = Self::key(&a.sup(&b), self.within);
-        let w2 = self.within * self.within;
+        let near = |p: &Point3| (c.closest_on_axis(p) - p).norm_squared() <= within * within;
+        let lo = Self::key(&a.inf(&b), self.cell);
+        let hi = Self::key(&a.sup(&b), self.cell);
+        let span = (0..3).fold(1u64, |n, k| {
+            n.saturating_mul(hi[k].abs_diff(lo[k]).saturating_add(1))
+        });
+        if span > self.points.len() as u64 {
+            return self.points.iter().any(near);
+        }
         (lo[0]..=hi[0]).any(|x| {
             (lo[1]..=hi[1]).any(|y| {
                 (lo[2]..=hi[2]).any(|z| {
-                    self.cells.get(&[x, y, z]).is_some_and(|ks| {
-                        ks.iter().any(|&k| {
-                            let p = &self.points[k as usize];
-                            (c.closest_on_axis(p) - p).norm_squared() <= w2
-                        })
-                    })
+                    self.cells
+                        .get(&[x, y, z])
+                        .is_some_and(|ks| ks.iter().any(|&k| near(self.point(k))))
                 })
             })
         })
@@ -493,48 +510,33 @@ fn touching_lifted(
             .enumerate()
             .filter(|(i, m)| m.kind.on_surface() && !footprints.get(*i).is_none())
     };
-    type Grid = std::collections::HashMap<[i64; 3], Vec<usize>>;
-    let key = |p: &[f64; 3], cell: f64| p.map(|x| (x / cell).floor() as i64);
     let mut out = Vec::new();
     // Each lifted contact in its cell (a reach wide) and the 26 around it.
     // The reach is at least the tool radius, which the options hold positive.
-    let cell = reach;
-    let mut grid: Grid = Default::default();
-    for k in 0..lifted.len() {
-        let c = key(&contact(k).into(), cell);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    grid.entry([c[0] + dx, c[1] + dy, c[2] + dz])
-                        .or_default()
-                        .push(k);
-                }
-            }
-        }
-    }
-    let listed = |m: &Move| grid.get(&key(&m.cc_point.into(), cell));
-    let work: usize = cuts().map(|(_, m)| listed(m).map_or(0, Vec::len)).sum();
+    let grid = PointGrid::new((0..lifted.len()).map(contact).collect(), reach);
+    let listed = |m: &Move| grid.listed(&m.cc_point);
+    let work: usize = cuts().map(|(_, m)| listed(m).len()).sum();
     if work <= coarse_work_per_move.saturating_mul(path.moves.len()) {
         for (n, (i, m)) in cuts().enumerate() {
             if n % CANCEL_EVERY == 0 && !keep_going() {
                 return None;
             }
-            let Some(ks) = listed(m) else {
-                continue;
-            };
+            let ks = listed(m);
             // The extent only where a lifted contact lies within reach.
             let c = m.cc_point;
-            if !ks.iter().any(|&k| (contact(k) - c).norm() <= reach) {
+            if !ks.iter().any(|&k| (grid.point(k) - c).norm() <= reach) {
                 continue;
             }
             let own = extent(i);
-            if ks.iter().any(|&k| touches(&c, own, k)) {
+            if ks.iter().any(|&k| touches(&c, own, k as usize)) {
                 out.push((i, own));
             }
         }
         return Some(out);
     }
     drop(grid);
+    type Grid = std::collections::HashMap<[i64; 3], Vec<usize>>;
+    let key = |p: &[f64; 3], cell: f64| p.map(|x| (x / cell).floor() as i64);
     // The finer grid: each lifted footprint's sphere in the cells its box meets (widened by
     // a little for rounding).
     let radius = |e: f64| e * (1.0 + TOUCH_SLACK) * (1.0 + ROUNDING_WIDENING);
@@ -625,24 +627,34 @@ pub fn tight_near_lifts(
         &extent,
         &mut || progress(0.0),
     )?;
-    // The swept balls near the candidates: the moves that come within `grow` of one's
-    // contact (where lifted points lie apart, the candidates' box holds most of the path).
+    // The swept balls near the candidates, in the index's box round them: the moves that
+    // come within reach of a sample's look. A sample lies within FOCUS_GROWTH times its
+    // footprint's extent of the contact (as the focus takes it) and looks at most 2r along
+    // its normal (the probe's reach and depth below) for balls of radius r. Where lifted
+    // points lie apart, the box holds most of the path.
     let mut region = crate::geom::Aabb::empty();
     for &(i, _) in &candidates {
         region.grow(&path.moves[i].cc_point);
     }
     let grow = reach + 2.0 * r;
     let (lo, hi) = (region.min.map(|x| x - grow), region.max.map(|x| x + grow));
-    let contacts: Vec<Point3> = candidates
+    let within = candidates
         .iter()
-        .map(|&(i, _)| path.moves[i].cc_point)
-        .collect();
-    let near_contacts = PointsNear::new(&contacts, grow);
-    let inside = |p: &Point3| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]);
+        .map(|&(_, own)| FOCUS_GROWTH * own + 3.0 * r)
+        .fold(grow, f64::max);
+    let contacts = PointGrid::new(
+        candidates
+            .iter()
+            .map(|&(i, _)| path.moves[i].cc_point)
+            .collect(),
+        within * (1.0 + ROUNDING_WIDENING),
+    );
+    let meets_box =
+        |a: &Point3, b: &Point3| (0..3).all(|k| a[k].min(b[k]) <= hi[k] && a[k].max(b[k]) >= lo[k]);
     let capsules: Vec<Capsule> = path
         .moves
         .windows(2)
-        .filter(|w| w[1].kind.on_surface() && (inside(&w[0].cl_point) || inside(&w[1].cl_point)))
+        .filter(|w| w[1].kind.on_surface())
         .map(|w| {
             let a = if w[0].kind.on_surface() {
                 w[0].cl_point
@@ -651,7 +663,7 @@ pub fn tight_near_lifts(
             };
             Capsule::new(a, w[1].cl_point)
         })
-        .filter(|c| near_contacts.any_within(c))
+        .filter(|c| meets_box(&c.start, &c.end()) && contacts.any_within(c, within))
         .collect();
     if capsules.is_empty() {
         return Some(tight);
@@ -1347,30 +1359,31 @@ mod tests {
     use crate::geom::Vector3;
 
     /// The moves near listed points are those that comparing every pair finds: 300 points
-    /// in a 10 mm cube, 3 000 moves from 0 to 8 mm long (long ones cross several cells),
+    /// in a 10 mm cube, 3 000 moves up to 0.5, 3 or 8 mm long (the 3 mm ones walk several
+    /// cells, the 8 mm ones span more cells than there are points and test each point),
     /// some within the distance of a point only between their ends; both answers occur.
     #[test]
-    fn points_near_finds_the_moves_every_pair_finds() {
+    fn point_grid_finds_the_moves_every_pair_finds() {
         let mut next = crate::testing::uniform(4_242);
         let mut at = || Point3::new(10.0 * next(), 10.0 * next(), 10.0 * next());
         let points: Vec<Point3> = (0..300).map(|_| at()).collect();
         let within = 0.7;
-        let near = PointsNear::new(&points, within);
+        let near = PointGrid::new(points.clone(), within);
         let mut next = crate::testing::uniform(99);
         let (mut yes, mut no) = (0, 0);
         for k in 0..3000 {
             let a = Point3::new(10.0 * next(), 10.0 * next(), 10.0 * next());
             let d = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-            let len = if k % 10 == 0 {
-                8.0 * next()
-            } else {
-                0.5 * next()
-            };
+            let len = match k % 10 {
+                0 => 8.0,
+                1 => 3.0,
+                _ => 0.5,
+            } * next();
             let c = Capsule::new(a, a + d.normalize() * len);
             let brute = points
                 .iter()
                 .any(|p| (c.closest_on_axis(p) - p).norm() <= within);
-            assert_eq!(near.any_within(&c), brute, "move {k}");
+            assert_eq!(near.any_within(&c, within), brute, "move {k}");
             if brute {
                 yes += 1;
             } else {

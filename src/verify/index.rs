@@ -264,9 +264,10 @@ impl CapsuleIndex {
         }
     }
 
-    /// As [`CapsuleIndex::emit_new`], for the capsules of `cell` whose bounding ball comes
-    /// within `half` of `mid` only; the others are neither reported nor marked (a second
-    /// cell listing one tests it again, with the same answer).
+    /// As [`CapsuleIndex::emit_new`], for the capsules of `cell` that may meet a query
+    /// segment within `half` of `mid` only ([`CapsuleIndex::near_query`]); the others are
+    /// neither reported nor marked (a second cell listing one tests it again, with the same
+    /// answer).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn emit_near(

@@ -64,7 +64,8 @@ pub enum ToolSide {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct VerifyOptions {
-    /// Samples on the surface in all, shared among patches by area. Default 1 000 000:
+    /// Samples on the surface in all, shared among patches by area (a sliver patch takes
+    /// a few more, to be sampled across as densely as the rest). Default 1 000 000:
     /// on a 50 × 50 mm part a spacing of 0.05 mm.
     pub samples: usize,
     /// The scallop height asked of the planner (mm): material left above it counts as
