@@ -401,19 +401,23 @@ const FINE_CELLS_PER_REACH: f64 = 32.0;
 /// keep two spheres that meet out of a shared cell (dimensionless).
 const ROUNDING_WIDENING: f64 = 1e-9;
 
-/// Points listed in the cells of a hash grid, each in its own cell and the 26 round it: the
-/// points within a cell's size of a place are listed in that place's cell.
+/// Points listed in the cells of a hash grid, each with a radius (mm): every cell within its
+/// radius of a point lists it.
 struct PointGrid {
     points: Vec<Point3>,
+    radii: Vec<f64>,
     /// Edge of a cell (mm).
     cell: f64,
     cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
 }
 
+type Cells = std::collections::HashMap<[i64; 3], Vec<u32>>;
+
 impl PointGrid {
-    /// Lists `points` in cells `cell` mm wide (positive).
+    /// Lists `points` in cells `cell` mm wide (positive), each in its own cell and the 26
+    /// round it: its radius is a cell's size.
     fn new(points: Vec<Point3>, cell: f64) -> Self {
-        let mut cells: std::collections::HashMap<[i64; 3], Vec<u32>> = Default::default();
+        let mut cells = Cells::default();
         for (k, p) in points.iter().enumerate() {
             let c = Self::key(p, cell);
             for dx in -1..=1 {
@@ -427,8 +431,33 @@ impl PointGrid {
                 }
             }
         }
+        let radii = vec![cell; points.len()];
         PointGrid {
             points,
+            radii,
+            cell,
+            cells,
+        }
+    }
+
+    /// Lists `points` with their `radii` (mm) in cells `cell` mm wide (positive): each in the
+    /// cells its ball's box meets (widened a little for rounding).
+    fn with_radii(points: Vec<Point3>, radii: Vec<f64>, cell: f64) -> Self {
+        let mut cells = Cells::default();
+        for (k, (p, &r)) in points.iter().zip(&radii).enumerate() {
+            let g = Vector3::repeat(r * (1.0 + ROUNDING_WIDENING));
+            let (lo, hi) = (Self::key(&(p - g), cell), Self::key(&(p + g), cell));
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        cells.entry([x, y, z]).or_default().push(k as u32);
+                    }
+                }
+            }
+        }
+        PointGrid {
+            points,
+            radii,
             cell,
             cells,
         }
@@ -443,35 +472,37 @@ impl PointGrid {
         &self.points[k as usize]
     }
 
-    /// The points listed in the cell of `p` (every one within a cell's size of it, and
-    /// others up to two cells away), by index.
+    /// The points listed in the cell of `p` (every one within its radius of it, and maybe
+    /// others), by index.
     fn listed(&self, p: &Point3) -> &[u32] {
         self.cells
             .get(&Self::key(p, self.cell))
             .map_or(&[], Vec::as_slice)
     }
 
-    /// Whether a point lies within `within` mm (at most a cell's size) of the segment of move
-    /// `c`: one within it of a point of the segment is listed in that point's cell, which
-    /// lies in the segment's box; where that box spans more cells than there are points,
-    /// each point is tested instead.
-    fn any_within(&self, c: &Capsule, within: f64) -> bool {
+    /// Whether a point lies within its radius of the segment of move `c`: such a point is
+    /// listed in the cell of the segment's nearest point, which lies in the segment's box;
+    /// where that box spans more cells than there are points, each point is tested instead.
+    fn any_within(&self, c: &Capsule) -> bool {
         let (a, b) = (c.start, c.end());
-        let near = |p: &Point3| (c.closest_on_axis(p) - p).norm_squared() <= within * within;
+        let near = |k: usize| {
+            let p = &self.points[k];
+            (c.closest_on_axis(p) - p).norm_squared() <= self.radii[k] * self.radii[k]
+        };
         let lo = Self::key(&a.inf(&b), self.cell);
         let hi = Self::key(&a.sup(&b), self.cell);
         let span = (0..3).fold(1u64, |n, k| {
             n.saturating_mul(hi[k].abs_diff(lo[k]).saturating_add(1))
         });
         if span > self.points.len() as u64 {
-            return self.points.iter().any(near);
+            return (0..self.points.len()).any(near);
         }
         (lo[0]..=hi[0]).any(|x| {
             (lo[1]..=hi[1]).any(|y| {
                 (lo[2]..=hi[2]).any(|z| {
                     self.cells
                         .get(&[x, y, z])
-                        .is_some_and(|ks| ks.iter().any(|&k| near(self.point(k))))
+                        .is_some_and(|ks| ks.iter().any(|&k| near(k as usize)))
                 })
             })
         })
@@ -638,16 +669,16 @@ pub fn tight_near_lifts(
     }
     let grow = reach + 2.0 * r;
     let (lo, hi) = (region.min.map(|x| x - grow), region.max.map(|x| x + grow));
-    let within = candidates
-        .iter()
-        .map(|&(_, own)| FOCUS_GROWTH * own + 3.0 * r)
-        .fold(grow, f64::max);
-    let contacts = PointGrid::new(
+    let contacts = PointGrid::with_radii(
         candidates
             .iter()
             .map(|&(i, _)| path.moves[i].cc_point)
             .collect(),
-        within * (1.0 + ROUNDING_WIDENING),
+        candidates
+            .iter()
+            .map(|&(_, own)| grow.max(FOCUS_GROWTH * own + 3.0 * r))
+            .collect(),
+        grow,
     );
     let meets_box =
         |a: &Point3, b: &Point3| (0..3).all(|k| a[k].min(b[k]) <= hi[k] && a[k].max(b[k]) >= lo[k]);
@@ -663,7 +694,7 @@ pub fn tight_near_lifts(
             };
             Capsule::new(a, w[1].cl_point)
         })
-        .filter(|c| meets_box(&c.start, &c.end()) && contacts.any_within(c, within))
+        .filter(|c| meets_box(&c.start, &c.end()) && contacts.any_within(c))
         .collect();
     if capsules.is_empty() {
         return Some(tight);
@@ -1359,38 +1390,53 @@ mod tests {
     use crate::geom::Vector3;
 
     /// The moves near listed points are those that comparing every pair finds: 300 points
-    /// in a 10 mm cube, 3 000 moves up to 0.5, 3 or 8 mm long (the 3 mm ones walk several
-    /// cells, the 8 mm ones span more cells than there are points and test each point),
-    /// some within the distance of a point only between their ends; both answers occur.
+    /// in a 10 mm cube, each within a cell's size (0.7 mm), and again with a twentieth of
+    /// them within up to 3.7 mm; 3 000 moves up to 0.5, 3 or 8 mm long (the 3 mm ones walk
+    /// several cells, the 8 mm ones span more cells than there are points and test each
+    /// point), some near a point only between their ends; both answers occur.
     #[test]
     fn point_grid_finds_the_moves_every_pair_finds() {
         let mut next = crate::testing::uniform(4_242);
-        let mut at = || Point3::new(10.0 * next(), 10.0 * next(), 10.0 * next());
-        let points: Vec<Point3> = (0..300).map(|_| at()).collect();
-        let within = 0.7;
-        let near = PointGrid::new(points.clone(), within);
-        let mut next = crate::testing::uniform(99);
-        let (mut yes, mut no) = (0, 0);
-        for k in 0..3000 {
-            let a = Point3::new(10.0 * next(), 10.0 * next(), 10.0 * next());
-            let d = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-            let len = match k % 10 {
-                0 => 8.0,
-                1 => 3.0,
-                _ => 0.5,
-            } * next();
-            let c = Capsule::new(a, a + d.normalize() * len);
-            let brute = points
-                .iter()
-                .any(|p| (c.closest_on_axis(p) - p).norm() <= within);
-            assert_eq!(near.any_within(&c, within), brute, "move {k}");
-            if brute {
-                yes += 1;
-            } else {
-                no += 1;
+        let points: Vec<Point3> = (0..300)
+            .map(|_| Point3::new(10.0 * next(), 10.0 * next(), 10.0 * next()))
+            .collect();
+        let cell = 0.7;
+        let radii: Vec<f64> = (0..points.len())
+            .map(|k| {
+                if k % 20 == 0 {
+                    cell + 3.0 * next()
+                } else {
+                    cell
+                }
+            })
+            .collect();
+        let grids = [
+            PointGrid::new(points.clone(), cell),
+            PointGrid::with_radii(points.clone(), radii, cell),
+        ];
+        for grid in &grids {
+            let mut next = crate::testing::uniform(99);
+            let (mut yes, mut no) = (0, 0);
+            for k in 0..3000 {
+                let a = Point3::new(10.0 * next(), 10.0 * next(), 10.0 * next());
+                let d = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+                let len = match k % 10 {
+                    0 => 8.0,
+                    1 => 3.0,
+                    _ => 0.5,
+                } * next();
+                let c = Capsule::new(a, a + d.normalize() * len);
+                let brute = (0..points.len())
+                    .any(|j| (c.closest_on_axis(&points[j]) - points[j]).norm() <= grid.radii[j]);
+                assert_eq!(grid.any_within(&c), brute, "move {k}");
+                if brute {
+                    yes += 1;
+                } else {
+                    no += 1;
+                }
             }
+            assert!(yes > 300 && no > 300, "{yes} near, {no} not");
         }
-        assert!(yes > 300 && no > 300, "{yes} near, {no} not");
     }
 
     /// The cut points found near lifted ones by the grid a reach wide and by the finer grid
