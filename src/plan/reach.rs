@@ -411,60 +411,70 @@ struct PointGrid {
     cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
 }
 
-type Cells = std::collections::HashMap<[i64; 3], Vec<u32>>;
-
 impl PointGrid {
     /// Lists `points` in cells `cell` mm wide (positive), each in its own cell and the 26
     /// round it: its radius is a cell's size.
     fn new(points: Vec<Point3>, cell: f64) -> Self {
-        let mut cells = Cells::default();
-        for (k, p) in points.iter().enumerate() {
-            let c = Self::key(p, cell);
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        cells
-                            .entry([c[0] + dx, c[1] + dy, c[2] + dz])
-                            .or_default()
-                            .push(k as u32);
+        let mut grid = PointGrid {
+            radii: vec![cell; points.len()],
+            points,
+            cell,
+            cells: Default::default(),
+        };
+        for k in 0..grid.points.len() {
+            let c = grid.key(&grid.points[k]);
+            for x in c[0] - 1..=c[0] + 1 {
+                for y in c[1] - 1..=c[1] + 1 {
+                    for z in c[2] - 1..=c[2] + 1 {
+                        grid.cells.entry([x, y, z]).or_default().push(k as u32);
                     }
                 }
             }
         }
-        let radii = vec![cell; points.len()];
-        PointGrid {
-            points,
-            radii,
-            cell,
-            cells,
-        }
+        grid
     }
 
     /// Lists `points` with their `radii` (mm) in cells `cell` mm wide (positive): each in the
     /// cells its ball's box meets (widened a little for rounding).
     fn with_radii(points: Vec<Point3>, radii: Vec<f64>, cell: f64) -> Self {
-        let mut cells = Cells::default();
-        for (k, (p, &r)) in points.iter().zip(&radii).enumerate() {
-            let g = Vector3::repeat(r * (1.0 + ROUNDING_WIDENING));
-            let (lo, hi) = (Self::key(&(p - g), cell), Self::key(&(p + g), cell));
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        cells.entry([x, y, z]).or_default().push(k as u32);
-                    }
-                }
-            }
-        }
-        PointGrid {
+        let mut grid = PointGrid {
             points,
             radii,
             cell,
-            cells,
+            cells: Default::default(),
+        };
+        for k in 0..grid.points.len() {
+            let at: Vec<[i64; 3]> = grid
+                .box_cells(&grid.points[k], grid.radii[k] * (1.0 + ROUNDING_WIDENING))
+                .collect();
+            for c in at {
+                grid.cells.entry(c).or_default().push(k as u32);
+            }
         }
+        grid
     }
 
-    fn key(p: &Point3, cell: f64) -> [i64; 3] {
-        [p.x, p.y, p.z].map(|x| (x / cell).floor() as i64)
+    fn key(&self, p: &Point3) -> [i64; 3] {
+        [p.x, p.y, p.z].map(|x| (x / self.cell).floor() as i64)
+    }
+
+    /// The cells the box from `lo` to `hi` meets.
+    fn cells_between(&self, lo: &Point3, hi: &Point3) -> impl Iterator<Item = [i64; 3]> {
+        let (lo, hi) = (self.key(lo), self.key(hi));
+        (lo[0]..=hi[0]).flat_map(move |x| {
+            (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
+        })
+    }
+
+    /// The cells the box of the ball of radius `r` round `c` meets.
+    fn box_cells(&self, c: &Point3, r: f64) -> impl Iterator<Item = [i64; 3]> {
+        let g = Vector3::repeat(r);
+        self.cells_between(&(c - g), &(c + g))
+    }
+
+    /// The points listed in cell `at`, by index.
+    fn in_cell(&self, at: &[i64; 3]) -> &[u32] {
+        self.cells.get(at).map_or(&[], Vec::as_slice)
     }
 
     /// The point with index `k`.
@@ -475,9 +485,7 @@ impl PointGrid {
     /// The points listed in the cell of `p` (every one within its radius of it, and maybe
     /// others), by index.
     fn listed(&self, p: &Point3) -> &[u32] {
-        self.cells
-            .get(&Self::key(p, self.cell))
-            .map_or(&[], Vec::as_slice)
+        self.in_cell(&self.key(p))
     }
 
     /// Whether a point lies within its radius of the segment of move `c`: such a point is
@@ -489,23 +497,16 @@ impl PointGrid {
             let p = &self.points[k];
             (c.closest_on_axis(p) - p).norm_squared() <= self.radii[k] * self.radii[k]
         };
-        let lo = Self::key(&a.inf(&b), self.cell);
-        let hi = Self::key(&a.sup(&b), self.cell);
+        let (lo, hi) = (a.inf(&b), a.sup(&b));
+        let (klo, khi) = (self.key(&lo), self.key(&hi));
         let span = (0..3).fold(1u64, |n, k| {
-            n.saturating_mul(hi[k].abs_diff(lo[k]).saturating_add(1))
+            n.saturating_mul(khi[k].abs_diff(klo[k]).saturating_add(1))
         });
         if span > self.points.len() as u64 {
             return (0..self.points.len()).any(near);
         }
-        (lo[0]..=hi[0]).any(|x| {
-            (lo[1]..=hi[1]).any(|y| {
-                (lo[2]..=hi[2]).any(|z| {
-                    self.cells
-                        .get(&[x, y, z])
-                        .is_some_and(|ks| ks.iter().any(|&k| near(k as usize)))
-                })
-            })
-        })
+        self.cells_between(&lo, &hi)
+            .any(|at| self.in_cell(&at).iter().any(|&k| near(k as usize)))
     }
 }
 
@@ -566,39 +567,33 @@ fn touching_lifted(
         return Some(out);
     }
     drop(grid);
-    type Grid = std::collections::HashMap<[i64; 3], Vec<usize>>;
-    let key = |p: &[f64; 3], cell: f64| p.map(|x| (x / cell).floor() as i64);
     // The finer grid: each lifted footprint's sphere in the cells its box meets (widened by
     // a little for rounding).
-    let radius = |e: f64| e * (1.0 + TOUCH_SLACK) * (1.0 + ROUNDING_WIDENING);
-    let mut spheres: Vec<f64> = lifted_extent.iter().map(|&e| radius(e)).collect();
+    let radius = |e: f64| e * (1.0 + TOUCH_SLACK);
+    let mut spheres: Vec<f64> = lifted_extent
+        .iter()
+        .map(|&e| radius(e) * (1.0 + ROUNDING_WIDENING))
+        .collect();
     let mid = spheres.len() / 2;
     let median = *spheres.select_nth_unstable_by(mid, f64::total_cmp).1;
     let fine = (2.0 * median).max(reach / FINE_CELLS_PER_REACH);
-    let cells = |c: &Point3, r: f64| {
-        let (lo, hi) = (
-            key(&[c.x - r, c.y - r, c.z - r], fine),
-            key(&[c.x + r, c.y + r, c.z + r], fine),
-        );
-        (lo[0]..=hi[0]).flat_map(move |x| {
-            (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
-        })
-    };
-    let mut grid: Grid = Default::default();
-    for k in 0..lifted.len() {
-        for at in cells(&contact(k), radius(lifted_extent[k])) {
-            grid.entry(at).or_default().push(k);
-        }
-    }
+    let grid = PointGrid::with_radii(
+        (0..lifted.len()).map(contact).collect(),
+        lifted_extent.iter().map(|&e| radius(e)).collect(),
+        fine,
+    );
     for (n, (i, m)) in cuts().enumerate() {
         if n % CANCEL_EVERY == 0 && !keep_going() {
             return None;
         }
         let (c, own) = (m.cc_point, extent(i));
-        let hit = cells(&c, radius(own).min(reach)).any(|at| {
-            grid.get(&at)
-                .is_some_and(|ks| ks.iter().any(|&k| touches(&c, own, k)))
-        });
+        let hit = grid
+            .box_cells(&c, (radius(own) * (1.0 + ROUNDING_WIDENING)).min(reach))
+            .any(|at| {
+                grid.in_cell(&at)
+                    .iter()
+                    .any(|&k| touches(&c, own, k as usize))
+            });
         if hit {
             out.push((i, own));
         }

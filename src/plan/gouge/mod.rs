@@ -642,13 +642,7 @@ mod tests {
                 .min(k.len() - 2)
         };
         let face = |q: [f64; 2]| (cell(&ku, q[0]) * 10 + cell(&kv, q[1])) as u32;
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::testing::uniform(12345);
         const SAMPLES: usize = 20_000;
         let mut changes = 0;
         for _ in 0..200 {
