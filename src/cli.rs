@@ -17,7 +17,8 @@ const USAGE: &str = "usage:
   tspath plan MODEL [--strategy isoparametric|isfc|watershed|multi-rectangle|isoplanar]
               [--isfc-plain] [--slice-angle DEG] [--no-deform] [--shear]
               [--tool-radius MM] [--scallop MM] [--chordal MM] [--feed MM_PER_MIN]
-              [--plunge-feed MM_PER_MIN] [--clearance MM] [--feed-height MM]
+              [--plunge-feed MM_PER_MIN] [--clearance MM] [--full-retract]
+              [--feed-height MM]
               [--max-cl-points N]
               [--start-patch N] [--finish-patch N] [--lead DEG] [--tilt DEG] [--max-tilt DEG]
               [--max-axis-step DEG]
@@ -54,9 +55,11 @@ above it; its bottom is the part's lowest point) [--zero WHERE]
 stock-top-corner, stock-bottom-centre, stock-bottom-corner (front-left: least X, Y), or a
 point x,y,z in mm of the placed model); `info` shows the placement, the millimetre box
 and the stock.
---clearance is the safe plane's height above the model (default 5 mm); the tool rapids
-down to --feed-height above each cut (default 2 mm, along its way down) and goes on at
---plunge-feed (default 300 mm/min).
+--clearance is the gap kept under the tool on rapids (default 5 mm): between cuts the tool
+rapids that high over what its ball, shank and holder pass above, or with --full-retract at
+the safe plane (the clearance and a ball diameter above the model and its stock, where the
+program starts and ends); it rapids down to --feed-height above each cut (default 2 mm,
+along its way down) and goes on at --plunge-feed (default 300 mm/min).
 --max-cl-points (default 2 000 000) refuses, before planning, settings whose estimated CL
 points exceed it, naming the estimate and the scallop that would fit.
 --max-axis-step (default 5°) is the largest turn of the tool axis from one cut point to
@@ -333,6 +336,7 @@ const PLAN_SWITCHES: &[&str] = &[
     "--no-deform",
     "--shear",
     "--on-table",
+    "--full-retract",
 ];
 
 /// The plan's own flags (with a value); `plan` and `compare` take these and the set-up's.
@@ -487,6 +491,9 @@ fn plan_setup(a: &Args) -> Result<(Model, machine::Machine, PlanOptions)> {
     }
     if a.has("--shear") {
         opts.isoplanar_shear = true;
+    }
+    if a.has("--full-retract") {
+        opts.full_retract = true;
     }
     Ok((m, mach, opts))
 }

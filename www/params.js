@@ -55,7 +55,8 @@ export const PARAMS = [
   { key: 'feed', field: 'feed_mm_min', group: 'feeds', label: 'Cutting feed', unit: 'mm/min', kind: 'number', min: 1, max: 100000, step: 50, default: 1000 },
   { key: 'plunge-feed', field: 'plunge_feed_mm_min', group: 'feeds', label: 'Plunge feed', unit: 'mm/min', kind: 'number', min: 1, max: 100000, step: 50, default: 300 },
   { key: 'spindle', field: 'spindle_rpm', group: 'feeds', label: 'Spindle speed', unit: 'rpm', kind: 'number', min: 1, max: 100000, step: 500, default: 12000 },
-  { key: 'clearance', field: 'clearance_mm', group: 'feeds', label: 'Clearance above the model', unit: 'mm', kind: 'number', min: 0.1, max: 500, step: 1, default: 5 },
+  { key: 'clearance', field: 'clearance_mm', group: 'feeds', label: 'Clearance under the tool on rapids', unit: 'mm', kind: 'number', min: 0.1, max: 500, step: 1, default: 5 },
+  { key: 'full-retract', field: 'full_retract', group: 'feeds', label: 'Rapids between cuts at the safe plane (else the clearance over what lies beneath)', kind: 'flag', default: false },
   { key: 'feed-height', field: 'feed_height_mm', group: 'feeds', label: 'Feed height above each cut', unit: 'mm', kind: 'number', min: 0, max: 500, step: 0.5, default: 2 },
   // Output (not plan options: they choose the program written from the plan)
   { key: 'machine', field: null, group: 'output', label: 'Machine', kind: 'choice', choices: [], default: '3-axis' },

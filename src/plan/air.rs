@@ -14,7 +14,7 @@
 use super::distance::SurfaceDistance;
 use super::toolpath::{Move, MoveKind, Toolpath};
 use super::PlanOptions;
-use crate::geom::{Point3, Vector3};
+use crate::geom::{least, most, Point3, Vector3};
 use crate::model::Model;
 
 /// What routing the air moves found.
@@ -27,6 +27,11 @@ pub struct AirStats {
     pub blocked: usize,
     /// The cut point of the first of those (ball centre, mm).
     pub first_blocked: Option<Point3>,
+    /// Rapids between cuts run below the safe plane, at the clearance over what lies
+    /// beneath them (see [`transit_height`]).
+    pub lowered: usize,
+    /// Length those save against rising to the safe plane (mm).
+    pub lowered_saving_mm: f64,
 }
 
 /// Tests whether the ball swept between two points stays out of the model.
@@ -169,7 +174,7 @@ pub fn route(
     // rapid above the next cut, before its plunge), and the way found.
     // Kept for the air moves only, by move index (a vector over every move would be
     // as large as a fifth of the path).
-    let legs: Vec<(usize, AirLeg)> = (0..moves.len())
+    let mut legs: Vec<(usize, AirLeg)> = (0..moves.len())
         .filter_map(|i| {
             let m = moves[i];
             let (cut, leg) = match m.kind {
@@ -219,6 +224,10 @@ pub fn route(
         leave_out.dedup();
         return Routed::LeaveOut(leave_out);
     }
+    if !opts.full_retract {
+        let beneath = Beneath::new(model, opts, dist, path.tool_radius_mm);
+        lower_transits(&mut legs, moves, &beneath, &mut stats);
+    }
     path.rebuild(|old, i, add| {
         let m = old.moves[i];
         let param = old.param(i);
@@ -259,6 +268,131 @@ pub fn route(
         }
     });
     Routed::Done(stats)
+}
+
+/// What a level rapid with the tool axis vertical must clear: the model's triangles beneath
+/// each part of the tool, and the stock where it was declared beyond the part.
+struct Beneath<'a> {
+    dist: &'a SurfaceDistance,
+    /// Per part of the tool: its radius, and how far its lowest point lies above the ball
+    /// centre (mm): the ball (radius r, r below), the flutes and shank (from the centre
+    /// up) and the holder (from the shank's length up).
+    parts: [(f64, f64); 3],
+    /// The gap kept (mm).
+    clearance: f64,
+    /// The stock's box where it reaches beyond the part's (it may still be there).
+    stock: Option<crate::geom::Aabb>,
+}
+
+/// Stock reaching beyond the part's box by less than this share of the model's size is the
+/// part's box (the placement rounds it).
+const STOCK_SAME_SHARE: f64 = 1e-9;
+
+/// A tool axis this close to +Z (length of the difference of unit vectors) is vertical.
+const AXIS_VERTICAL: f64 = 1e-12;
+
+impl<'a> Beneath<'a> {
+    fn new(model: &Model, opts: &PlanOptions, dist: &'a SurfaceDistance, r: f64) -> Self {
+        let (bbox, stock) = (model.surface.bbox(), model.stock);
+        let size = (0..3)
+            .map(|k| bbox.max[k] - bbox.min[k])
+            .fold(0.0, f64::max);
+        let beyond = (0..3).any(|k| {
+            stock.min[k] < bbox.min[k] - STOCK_SAME_SHARE * size
+                || stock.max[k] > bbox.max[k] + STOCK_SAME_SHARE * size
+        });
+        Beneath {
+            dist,
+            parts: [
+                (r, -r),
+                (r.max(opts.shank_radius()), 0.0),
+                (opts.holder_radius_mm, opts.shank_length_mm),
+            ],
+            clearance: opts.clearance_mm,
+            stock: beyond.then_some(stock),
+        }
+    }
+
+    /// The lowest ball-centre height (mm) at which a vertical tool moves level from above
+    /// `a` to above `b` (plan view) keeping every part the clearance above all it passes
+    /// over: the model's surface within the part's radius and the clearance (found from the
+    /// triangles, grown by their tolerance), and the stock's top where the stock lies
+    /// there. `None` where nothing lies beneath.
+    fn transit_height(&self, a: [f64; 2], b: [f64; 2]) -> Option<f64> {
+        let (c, tol) = (self.clearance, self.dist.tolerance_mm);
+        self.parts
+            .iter()
+            .filter_map(|&(rho, lowest)| {
+                let reach = rho + c + tol;
+                let surface = self.dist.highest_under(a, b, reach).map(|z| z + tol);
+                let stock = self.stock.and_then(|s| {
+                    let near = (0..2).all(|k| {
+                        least(a[k], b[k]) - reach <= s.max[k]
+                            && most(a[k], b[k]) + reach >= s.min[k]
+                    });
+                    near.then_some(s.max[2])
+                });
+                let top = match (surface, stock) {
+                    (Some(x), Some(y)) => Some(most(x, y)),
+                    (x, y) => x.or(y),
+                }?;
+                Some(top + c - lowest)
+            })
+            .reduce(most)
+    }
+}
+
+/// Lowers each rapid between two cuts (a retract's way up, then the way down to the next
+/// cut) from the safe plane to its [`Beneath::transit_height`], where the tool axis is
+/// vertical at both ends and the ways have a top to lower: the way up and down keep their
+/// points (they were found clear up to the safe plane, and now stop lower on the same
+/// lines), and the level move between them clears what lies beneath.
+fn lower_transits(
+    legs: &mut [(usize, AirLeg)],
+    moves: &[Move],
+    beneath: &Beneath,
+    stats: &mut AirStats,
+) {
+    let vertical = |m: &Move| (m.tool_axis - Vector3::z()).norm() <= AXIS_VERTICAL;
+    for k in 1..legs.len() {
+        let (head, tail) = legs.split_at_mut(k);
+        let (i, (cut_a, Leg::Leaving, Some(up))) = &mut head[k - 1] else {
+            continue;
+        };
+        let (j, (cut_b, Leg::Arriving, Some(down))) = &mut tail[0] else {
+            continue;
+        };
+        if *j != *i + 1
+            || ![*cut_a, *i, *j, *cut_b]
+                .iter()
+                .all(|&x| vertical(&moves[x]))
+        {
+            continue;
+        }
+        let (Some(&top_a), Some(&top_b)) = (up.last(), down.last()) else {
+            continue;
+        };
+        let Some(over) = beneath.transit_height([top_a.x, top_a.y], [top_b.x, top_b.y]) else {
+            continue;
+        };
+        // Never below a point of the ways (they keep rising to the top), nor below either
+        // cut.
+        let floor = up[..up.len() - 1]
+            .iter()
+            .chain(&down[..down.len() - 1])
+            .map(|p| p.z)
+            .chain([moves[*cut_a].cl_point.z, moves[*cut_b].cl_point.z])
+            .fold(over, most);
+        let safe = most(top_a.z, top_b.z);
+        if floor < safe {
+            if let (Some(p), Some(q)) = (up.last_mut(), down.last_mut()) {
+                stats.lowered += 1;
+                stats.lowered_saving_mm += (p.z - floor) + (q.z - floor);
+                p.z = floor;
+                q.z = floor;
+            }
+        }
+    }
 }
 
 /// The length of the way down (`down`, then the cut at `cut`) below height `z` (mm): from
@@ -328,6 +462,58 @@ fn split_at_feed_height(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_level_rapid_clears_the_highest_point_beneath_each_part_of_the_tool() {
+        let mut m = crate::model::samples::load_sample("bumps").unwrap();
+        let bb = m.surface.bbox();
+        let dist = SurfaceDistance::new(&m, 0.01);
+        let tol = dist.tolerance_mm;
+        let mut opts = PlanOptions::default().with_tool_radius(1.0);
+        // A short move beside the model: nothing beneath.
+        let out = [bb.max[0] + 30.0, bb.min[1]];
+        let beneath = Beneath::new(&m, &opts, &dist, 1.0);
+        assert_eq!(beneath.transit_height(out, [out[0] + 5.0, out[1]]), None);
+        // Across the whole model: the ball passes over its highest point (the highest
+        // triangle corner lies within the tolerance of the surface's box).
+        let (a, b) = (
+            [bb.min[0], 0.5 * (bb.min[1] + bb.max[1])],
+            [bb.max[0], 0.5 * (bb.min[1] + bb.max[1])],
+        );
+        let over = beneath.transit_height(a, b).unwrap();
+        let want = bb.max[2] + 5.0 + 1.0;
+        assert!((over - want).abs() <= 2.0 * tol, "{over} against {want}");
+        // Along the front edge the ball passes over the plate; a holder 100 mm wide 1 mm
+        // above the ball centre passes over the top and decides.
+        let (a, b) = ([bb.min[0], bb.min[1]], [bb.max[0], bb.min[1]]);
+        let low = beneath.transit_height(a, b).unwrap();
+        assert!(low < want - 1.0, "{low}");
+        opts.holder_radius_mm = 100.0;
+        opts.shank_length_mm = 1.0;
+        let wide = Beneath::new(&m, &opts, &dist, 1.0)
+            .transit_height(a, b)
+            .unwrap();
+        let want_wide = bb.max[2] + 5.0 - 1.0;
+        assert!(
+            (wide - want_wide).abs() <= 2.0 * tol,
+            "{wide} against {want_wide}"
+        );
+        // Stock declared 4 mm above the part: its top is beneath every part.
+        m.stock.max[2] = bb.max[2] + 4.0;
+        let stocked = Beneath::new(&m, &opts, &dist, 1.0)
+            .transit_height(a, b)
+            .unwrap();
+        assert!(
+            (stocked - (bb.max[2] + 4.0 + 5.0 + 1.0)).abs() < 1e-9,
+            "{stocked}"
+        );
+        // ... and nothing beside it.
+        assert_eq!(
+            Beneath::new(&m, &opts, &dist, 1.0)
+                .transit_height([out[0] + 200.0, out[1]], [out[0] + 205.0, out[1]]),
+            None
+        );
+    }
 
     #[test]
     fn a_ray_leaves_the_box_through_the_nearest_wall() {

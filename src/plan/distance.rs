@@ -254,6 +254,43 @@ impl SurfaceDistance {
         .is_some()
     }
 
+    /// The highest corner (z, mm) of the triangles whose plan view (their projection on XY)
+    /// comes within `rho` (mm) of the plan view of the segment from `a` to `b`, or `None`
+    /// where none does: what a vertical tool `rho` wide passes over, moving level from above
+    /// `a` to above `b`. Exact against the triangles' corners (a triangle counts with its
+    /// highest corner wherever it comes near); callers add [`Self::tolerance_mm`].
+    pub fn highest_under(&self, a: [f64; 2], b: [f64; 2], rho: f64) -> Option<f64> {
+        let best = std::cell::Cell::new(f64::NEG_INFINITY);
+        let lo = [least(a[0], b[0]) - rho, least(a[1], b[1]) - rho];
+        let hi = [most(a[0], b[0]) + rho, most(a[1], b[1]) + rho];
+        let flat = |q: [f64; 2]| Point3::new(q[0], q[1], 0.0);
+        let (fa, fb) = (flat(a), flat(b));
+        self.leaves_meeting(
+            |n: &Wide| {
+                // Children whose plan view meets the segment's box grown by `rho`, and that
+                // reach above the highest corner found so far.
+                std::array::from_fn(|j| {
+                    n.lo[0][j] <= hi[0]
+                        && n.hi[0][j] >= lo[0]
+                        && n.lo[1][j] <= hi[1]
+                        && n.hi[1][j] >= lo[1]
+                        && n.hi[2][j] > best.get()
+                })
+            },
+            |t: &Tri| {
+                let c = t.corners();
+                let top = most(most(c[0].z, c[1].z), c[2].z);
+                if top > best.get()
+                    && segment_triangle_distance(&fa, &fb, &c.map(|q| flat([q.x, q.y]))) <= rho
+                {
+                    best.set(top);
+                }
+                None::<()>
+            },
+        );
+        (best.get() > f64::NEG_INFINITY).then(|| best.get())
+    }
+
     /// A point of a triangle inside the flat-ended cylinder of radius `rad` along unit
     /// `axis` from `c + axis·a0` to `c + axis·a1`, if there is one (exact against the
     /// triangles; callers grow the cylinder by [`Self::tolerance_mm`] for the surface).
@@ -917,6 +954,89 @@ mod tests {
         assert!(
             agree > 10,
             "some segments must come near the surface: {agree}"
+        );
+    }
+
+    #[test]
+    fn the_highest_point_under_a_level_move_bounds_the_surface_beneath_it() {
+        let m = crate::model::samples::load_sample("keycap-convex").unwrap();
+        let dist = SurfaceDistance::new(&m, 0.01);
+        let bb = m.surface.bbox();
+        // The surface itself, sampled densely (independent of the triangles).
+        let n = 120;
+        let below: Vec<Point3> = (0..m.surface.faces().len())
+            .flat_map(|f| {
+                let m = &m;
+                (0..=n).flat_map(move |i| {
+                    (0..=n)
+                        .map(move |j| m.surface.subs(f, i as f64 / n as f64, j as f64 / n as f64))
+                })
+            })
+            .collect();
+        let plan_dist = |a: [f64; 2], b: [f64; 2], q: &Point3| {
+            let (d, p) = ([b[0] - a[0], b[1] - a[1]], [q.x - a[0], q.y - a[1]]);
+            let len2 = d[0] * d[0] + d[1] * d[1];
+            let t = if len2 > 0.0 {
+                ((p[0] * d[0] + p[1] * d[1]) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (p[0] - t * d[0]).hypot(p[1] - t * d[1])
+        };
+        let mut rnd = crate::testing::uniform(777u64);
+        let (mut met, mut missed) = (0, 0);
+        for k in 0..60 {
+            let (p, q) = (around(&bb, &mut rnd), around(&bb, &mut rnd));
+            // Every fifth beside the model, a millimetre or two from its box.
+            let aside = if k % 5 == 4 {
+                bb.max[0] - bb.min[0] + 1.0 + 2.0 * rnd()
+            } else {
+                0.0
+            };
+            let (a, b) = ([p.x + aside, p.y], [q.x + aside, q.y]);
+            let rho = if k % 2 == 0 { 0.3 * rnd() } else { 3.0 * rnd() };
+            let got = dist.highest_under(a, b, rho);
+            // The hierarchy prunes nothing it should not: every triangle tested finds the same.
+            let brute = dist
+                .tris
+                .iter()
+                .map(|t| t.corners())
+                .filter(|c| {
+                    let flat = c.map(|x| Point3::new(x.x, x.y, 0.0));
+                    segment_triangle_distance(
+                        &Point3::new(a[0], a[1], 0.0),
+                        &Point3::new(b[0], b[1], 0.0),
+                        &flat,
+                    ) <= rho
+                })
+                .map(|c| c[0].z.max(c[1].z).max(c[2].z))
+                .fold(None, |acc: Option<f64>, z| {
+                    Some(acc.map_or(z, |x| x.max(z)))
+                });
+            assert_eq!(got, brute);
+            // No surface point within `rho` of the move in plan view lies above it (with
+            // the tessellation's tolerance), and one near it comes close to it.
+            let near: Vec<&Point3> = below.iter().filter(|x| plan_dist(a, b, x) <= rho).collect();
+            match got {
+                Some(top) => {
+                    met += 1;
+                    for x in &near {
+                        assert!(x.z <= top + dist.tolerance_mm, "{} over {top}", x.z);
+                    }
+                }
+                None => {
+                    missed += 1;
+                    assert!(
+                        near.is_empty(),
+                        "{} surface points under a move over nothing",
+                        near.len()
+                    );
+                }
+            }
+        }
+        assert!(
+            met > 20 && missed > 0,
+            "{met} moves over the surface, {missed} beside it"
         );
     }
 

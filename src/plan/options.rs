@@ -27,9 +27,16 @@ pub struct PlanOptions {
     /// Largest distance between a straight feed move and the surface curve it replaces
     /// (mm). Default 0.005 mm, half the default scallop.
     pub chordal_mm: f64,
-    /// Height of the safe plane above the model's highest point, for rapids (mm).
-    /// Default 5 mm.
+    /// Gap kept between the tool (ball, shank and holder) and the model on rapids (mm):
+    /// rapids between cuts run this high over what lies beneath them, and the safe plane
+    /// (the first approach, the last retract, and every rapid with `full_retract`) lies this
+    /// far above the model's highest point and its stock, and a ball diameter more. Default 5 mm.
     pub clearance_mm: f64,
+    /// Every rapid between cuts at the safe plane, as high as the first and the last,
+    /// instead of only as high as the clearance over what the tool passes above (the
+    /// model beneath the ball, shank and holder, and the stock where it stands above the
+    /// part). Default false: the shorter way, "minimum retraction".
+    pub full_retract: bool,
     /// Cutting feed (mm/min). Default 1000 mm/min.
     pub feed_mm_min: f64,
     /// Feed for plunging into the first cut (mm/min). Default 300 mm/min.
@@ -177,6 +184,7 @@ impl Default for PlanOptions {
             scallop_mm: 0.01,
             chordal_mm: 0.005,
             clearance_mm: 5.0,
+            full_retract: false,
             feed_mm_min: 1000.0,
             plunge_feed_mm_min: 300.0,
             feed_height_mm: 2.0,

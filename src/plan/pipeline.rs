@@ -490,6 +490,12 @@ impl Planned {
                 self.air.escaped
             ));
         }
+        if self.air.lowered > 0 {
+            r.notes.push(format!(
+                "{} rapid(s) between cuts run the clearance ({} mm) over what the ball, shank and holder pass above, not at the safe plane: {:.1} mm less air (--full-retract keeps them at the safe plane)",
+                self.air.lowered, opts.clearance_mm, self.air.lowered_saving_mm
+            ));
+        }
         // What is left undone.
         r.unreachable_area_mm2 = self.rest.area_mm2;
         r.rest = self.rest.regions.clone();
