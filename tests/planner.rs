@@ -891,21 +891,28 @@ fn passes_keep_the_predicted_scallop_next_to_hole_corners() {
 
 /// Rapids between cuts run the clearance over what lies beneath them ("minimum
 /// retraction"), not at the safe plane: the whole tool (ball, flutes, shank, holder) keeps
-/// the clearance from the surface on every level rapid, checked every 0.5 mm against dense
-/// surface samples, and `full_retract` keeps every level rapid at the safe plane with the
-/// cuts unchanged. Bumps-hole's watershed plan (r 1 mm, h 0.05 mm) retracts four times;
-/// with a wide holder 1 mm above the ball centre, which leaves walls unreached, 25 times.
+/// the gap (the clearance, or the feed height where that is more) from the surface on every
+/// level rapid, checked every 0.5 mm against dense surface samples, and over the stock's
+/// top where stock is declared; `full_retract` keeps every level rapid at the safe plane
+/// with the cuts unchanged. Bumps-hole's watershed plan (r 1 mm, h 0.05 mm) retracts four
+/// times; with a wide holder 1 mm above the ball centre, which leaves walls unreached, 25
+/// times.
 #[test]
 fn rapids_between_cuts_keep_the_clearance_over_what_lies_beneath() {
-    let m = samples::load_sample("bumps-hole").unwrap();
-    let grid = SampleGrid::new(&dense_samples(&m), 2.0);
+    let plain = samples::load_sample("bumps-hole").unwrap();
+    let grid = SampleGrid::new(&dense_samples(&plain), 2.0);
     let base = PlanOptions::default()
         .with_tool_radius(1.0)
         .with_scallop(0.05)
         .with_strategy(tspath::plan::Strategy::Watershed);
-    // (holder radius, shank length, flute length, clearance) in mm.
-    for (holder, shank, flutes, clearance) in [(10.0, 20.0, None, 5.0), (25.0, 1.0, Some(0.5), 1.0)]
-    {
+    // (holder radius, shank length, flute length, clearance, stock above the part) in mm.
+    for (holder, shank, flutes, clearance, stock) in [
+        (10.0, 20.0, None, 5.0, 0.0),
+        (25.0, 1.0, Some(0.5), 1.0, 0.0),
+        (10.0, 20.0, None, 5.0, 4.0),
+    ] {
+        let mut m = plain.clone();
+        m.stock.max[2] += stock;
         let mut opts = base.clone().with_clearance(clearance);
         (opts.holder_radius_mm, opts.shank_length_mm) = (holder, shank);
         opts.flute_length_mm = flutes;
@@ -935,8 +942,7 @@ fn rapids_between_cuts_keep_the_clearance_over_what_lies_beneath() {
             p.moves
                 .windows(2)
                 .filter(|w| {
-                    w.iter()
-                        .all(|x| matches!(x.kind, MoveKind::Retract | MoveKind::Rapid))
+                    w.iter().all(|x| x.kind.rapid())
                         && (w[0].cl_point.z - w[1].cl_point.z).abs() < 1e-9
                         && (w[0].cl_point - w[1].cl_point).norm() > 1e-6
                 })
@@ -946,17 +952,22 @@ fn rapids_between_cuts_keep_the_clearance_over_what_lies_beneath() {
         assert!(level(&full).iter().all(|(a, _)| (a.z - safe).abs() < 1e-9));
         let lowered: Vec<(Point3, Point3)> = level(&low)
             .into_iter()
-            .filter(|(a, _)| a.z < safe - 1.0)
+            .filter(|(a, _)| a.z < safe - 1e-6)
             .collect();
+        let what = format!(
+            "holder r {holder} mm at {shank} mm, clearance {clearance} mm, stock {stock} mm above"
+        );
         // Four transits with the usual holder; the wide one leaves walls unreached, and
         // the cuts split round them retract more.
         assert!(
             lowered.len() >= 4,
-            "holder {holder} mm: {} transits lowered",
+            "{what}: {} transits lowered",
             lowered.len()
         );
-        let (r, c) = (opts.tool_radius_mm, opts.clearance_mm);
-        let reach = c + 1.0;
+        let r = opts.tool_radius_mm;
+        let gap = clearance.max(opts.feed_height_mm);
+        // Distances looked for: up to 1 mm past the gap from the ball (its centre r more).
+        let reach = gap + r + 1.0;
         // Least clearance of the ball and flutes, and of the shank and holder.
         let (mut ball_least, mut holder_least) = (reach, reach);
         for (a, b) in &lowered {
@@ -974,6 +985,10 @@ fn rapids_between_cuts_keep_the_clearance_over_what_lies_beneath() {
                 holder_least =
                     holder_least.min(tool_clearance(&grid, &opts, p, Vector3::z(), reach));
             }
+            // Over the stock's top by the gap.
+            if stock > 0.0 {
+                assert!(a.z - r >= m.stock.max[2] + gap - 1e-9, "{what}: {}", a.z);
+            }
         }
         let least = ball_least.min(holder_least);
         let lengths = [&low, &full].map(|p| {
@@ -983,7 +998,7 @@ fn rapids_between_cuts_keep_the_clearance_over_what_lies_beneath() {
                 .sum::<f64>()
         });
         println!(
-            "holder r {holder} mm at {shank} mm: {} transits at {:?} mm (safe plane {safe:.3}), least clearance {ball_least:.4} mm (ball, flutes), {holder_least:.4} mm (shank, holder), path {:.1} mm against {:.1}",
+            "{what}: {} transits at {:?} mm (safe plane {safe:.3}), least clearance {ball_least:.4} mm (ball, flutes), {holder_least:.4} mm (shank, holder; {reach} mm: none nearer), path {:.1} mm against {:.1}",
             lowered.len(),
             lowered.iter().map(|(a, _)| format!("{:.3}", a.z)).collect::<Vec<_>>(),
             lengths[0],
@@ -991,7 +1006,7 @@ fn rapids_between_cuts_keep_the_clearance_over_what_lies_beneath() {
         );
         // Dense samples stand 0.3 mm apart: between them the surface may lie 0.011 mm
         // nearer a 1 mm ball; 0.02 mm covers that and the tessellation's 0.01 mm.
-        assert!(least >= c - 0.02, "holder {holder} mm: {least} mm");
-        assert!(lengths[0] < lengths[1] - 10.0);
+        assert!(least >= gap - 0.02, "{what}: {least} mm");
+        assert!(lengths[0] < lengths[1] - 1.0);
     }
 }

@@ -19,7 +19,7 @@ export const KINDS = [
   { name: 'feed', label: 'cutting (colour of its patch)', colour: null, dashed: false },
   { name: 'link', label: 'link on the surface between cuts', colour: 0x111111, dashed: false },
   { name: 'retract', label: 'retraction', colour: 0xd62728, dashed: true },
-  { name: 'rapid', label: 'rapid above the model', colour: 0xd62728, dashed: true },
+  { name: 'rapid', label: 'rapid, clear of the model', colour: 0xd62728, dashed: true },
   { name: 'plunge', label: 'plunge onto the surface', colour: 0xff7f0e, dashed: false },
   { name: 'approach', label: 'approach from the feed height, at the plunge feed', colour: 0xff7f0e, dashed: true },
 ];

@@ -20,7 +20,7 @@
 //! At the singular pose the inner rotary keeps its value and the next move takes the smallest
 //! step. Anything else (a far turn, the other branch when it is not the smaller step) is a
 //! swing while cutting; when the limits leave only swings, that is an error naming the move. At
-//! the first move of a chain (a rapid, above the part) the rotaries may take any solution
+//! the first move of a chain (a rapid, clear of the part) the rotaries may take any solution
 //! within their limits: that is where they are unwound.
 //!
 //! Among all the sequences these rules allow, the one with the least total rotary travel
@@ -46,7 +46,7 @@ const STEP_TIE_DEG: f64 = 1e-6;
 const SAME_STATE_DEG: f64 = 1e-9;
 
 /// One pose the machine must reach: tool tip and axis in the workpiece frame, and whether
-/// it starts a chain (a rapid above the part, where the rotaries may re-choose).
+/// it starts a chain (a rapid clear of the part, where the rotaries may re-choose).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PoseRequest {
     pub tip: Point3,

@@ -797,10 +797,12 @@ pub fn post_program(
                 }
             }
         }
-        // A rapid that turns the rotaries would sweep the tip along a curve, and on a
-        // table machine swing the part up towards the tool: turn them at the top of Z
-        // first, as at the start of the program.
-        if rapid && rot_moves && mode == OutputMode::Joints && last_tip.is_some() {
+        // A rapid that turns the rotaries would sweep the tip along a curve (in joint
+        // output, and in tool-tip output on a control that does not keep the tip on the
+        // line at the rapid rate), and on a table machine swing the part up towards the
+        // tool, which may now stand only the clearance over the part (rapids between cuts
+        // run no higher): turn them at the top of Z first, as at the start of the program.
+        if rapid && rot_moves && last_tip.is_some() {
             o.motion(&safe_top());
             o.motion(&Motion {
                 rapid: true,

@@ -3,8 +3,9 @@
 //! Owns: the geometry of retracts and approaches (the moves between the last cut point, the
 //! safe plane and the next cut point). Must not: change cutting moves or tool axes.
 //!
-//! The planner retracts straight up to the safe plane and comes straight down onto the next
-//! cut. The ball's way is checked by exact distances to a tessellation of the surface
+//! The planner retracts straight up and comes straight down onto the next cut; between
+//! cuts the tool rises only as high as the clearance over what it passes above (or to the
+//! safe plane, with `full_retract`). The ball's way is checked by exact distances to a tessellation of the surface
 //! ([`super::distance`]). Where the ball's way up would pass through the model (under an overhang, on the
 //! underside of a closed part reached with a tilted axis) the tool first backs out along
 //! its own axis, through the space its shank and holder occupied (which the axis search kept
@@ -28,7 +29,7 @@ pub struct AirStats {
     /// The cut point of the first of those (ball centre, mm).
     pub first_blocked: Option<Point3>,
     /// Rapids between cuts run below the safe plane, at the clearance over what lies
-    /// beneath them (see [`transit_height`]).
+    /// beneath them (see `Beneath::transit_height`).
     pub lowered: usize,
     /// Length those save against rising to the safe plane (mm).
     pub lowered_saving_mm: f64,
@@ -278,8 +279,9 @@ struct Beneath<'a> {
     /// centre (mm): the ball (radius r, r below), the flutes and shank (from the centre
     /// up) and the holder (from the shank's length up).
     parts: [(f64, f64); 3],
-    /// The gap kept (mm).
-    clearance: f64,
+    /// The gap kept (mm): the clearance, and no less than the feed height, as the tool
+    /// comes down at the rapid rate no nearer a cut than that.
+    gap: f64,
     /// The stock's box where it reaches beyond the part's (it may still be there).
     stock: Option<crate::geom::Aabb>,
 }
@@ -308,18 +310,19 @@ impl<'a> Beneath<'a> {
                 (r.max(opts.shank_radius()), 0.0),
                 (opts.holder_radius_mm, opts.shank_length_mm),
             ],
-            clearance: opts.clearance_mm,
+            gap: most(opts.clearance_mm, opts.feed_height_mm),
             stock: beyond.then_some(stock),
         }
     }
 
     /// The lowest ball-centre height (mm) at which a vertical tool moves level from above
-    /// `a` to above `b` (plan view) keeping every part the clearance above all it passes
-    /// over: the model's surface within the part's radius and the clearance (found from the
-    /// triangles, grown by their tolerance), and the stock's top where the stock lies
-    /// there. `None` where nothing lies beneath.
+    /// `a` to above `b` (plan view) keeping every part the gap above all it may pass over:
+    /// the model's surface within the part's radius and the gap of the rectangle the two
+    /// points span (a rapid need not run straight; found from the triangles, grown by
+    /// their tolerance), and the stock's top where the stock lies there. `None` where
+    /// nothing lies beneath.
     fn transit_height(&self, a: [f64; 2], b: [f64; 2]) -> Option<f64> {
-        let (c, tol) = (self.clearance, self.dist.tolerance_mm);
+        let (c, tol) = (self.gap, self.dist.tolerance_mm);
         self.parts
             .iter()
             .filter_map(|&(rho, lowest)| {

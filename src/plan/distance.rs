@@ -254,35 +254,36 @@ impl SurfaceDistance {
         .is_some()
     }
 
-    /// The highest corner (z, mm) of the triangles whose plan view (their projection on XY)
-    /// comes within `rho` (mm) of the plan view of the segment from `a` to `b`, or `None`
-    /// where none does: what a vertical tool `rho` wide passes over, moving level from above
-    /// `a` to above `b`. Exact against the triangles' corners (a triangle counts with its
-    /// highest corner wherever it comes near); callers add [`Self::tolerance_mm`].
+    /// The highest corner (z, mm) of the triangles whose plan view (their box projected on
+    /// XY) meets the rectangle spanned by `a` and `b` grown by `rho` on every side (mm), or
+    /// `None` where none does: what a vertical tool `rho` wide may pass over on a rapid from
+    /// above `a` to above `b`, on a control that moves each axis at its own rate (the tool
+    /// then keeps within that rectangle, not on the line). Callers add
+    /// [`Self::tolerance_mm`].
     pub fn highest_under(&self, a: [f64; 2], b: [f64; 2], rho: f64) -> Option<f64> {
         let best = std::cell::Cell::new(f64::NEG_INFINITY);
         let lo = [least(a[0], b[0]) - rho, least(a[1], b[1]) - rho];
         let hi = [most(a[0], b[0]) + rho, most(a[1], b[1]) + rho];
-        let flat = |q: [f64; 2]| Point3::new(q[0], q[1], 0.0);
-        let (fa, fb) = (flat(a), flat(b));
+        let meets = |l: [f64; 2], h: [f64; 2]| {
+            l[0] <= hi[0] && h[0] >= lo[0] && l[1] <= hi[1] && h[1] >= lo[1]
+        };
         self.leaves_meeting(
             |n: &Wide| {
-                // Children whose plan view meets the segment's box grown by `rho`, and that
-                // reach above the highest corner found so far.
+                // Children whose plan view meets the rectangle and that reach above the
+                // highest corner found so far.
                 std::array::from_fn(|j| {
-                    n.lo[0][j] <= hi[0]
-                        && n.hi[0][j] >= lo[0]
-                        && n.lo[1][j] <= hi[1]
-                        && n.hi[1][j] >= lo[1]
+                    meets([n.lo[0][j], n.lo[1][j]], [n.hi[0][j], n.hi[1][j]])
                         && n.hi[2][j] > best.get()
                 })
             },
             |t: &Tri| {
                 let c = t.corners();
+                let (l, h) = (
+                    [0, 1].map(|k| least(least(c[0][k], c[1][k]), c[2][k])),
+                    [0, 1].map(|k| most(most(c[0][k], c[1][k]), c[2][k])),
+                );
                 let top = most(most(c[0].z, c[1].z), c[2].z);
-                if top > best.get()
-                    && segment_triangle_distance(&fa, &fb, &c.map(|q| flat([q.x, q.y]))) <= rho
-                {
+                if top > best.get() && meets(l, h) {
                     best.set(top);
                 }
                 None::<()>
@@ -973,15 +974,9 @@ mod tests {
                 })
             })
             .collect();
-        let plan_dist = |a: [f64; 2], b: [f64; 2], q: &Point3| {
-            let (d, p) = ([b[0] - a[0], b[1] - a[1]], [q.x - a[0], q.y - a[1]]);
-            let len2 = d[0] * d[0] + d[1] * d[1];
-            let t = if len2 > 0.0 {
-                ((p[0] * d[0] + p[1] * d[1]) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (p[0] - t * d[0]).hypot(p[1] - t * d[1])
+        // Whether `q` lies in the rectangle spanned by `a` and `b` grown by `rho`.
+        let inside = |a: [f64; 2], b: [f64; 2], rho: f64, q: &Point3| {
+            (0..2).all(|k| q[k] >= a[k].min(b[k]) - rho && q[k] <= a[k].max(b[k]) + rho)
         };
         let mut rnd = crate::testing::uniform(777u64);
         let (mut met, mut missed) = (0, 0);
@@ -997,31 +992,38 @@ mod tests {
             let rho = if k % 2 == 0 { 0.3 * rnd() } else { 3.0 * rnd() };
             let got = dist.highest_under(a, b, rho);
             // The hierarchy prunes nothing it should not: every triangle tested finds the same.
+            // A triangle's plan-view box meets the rectangle where the two ranges overlap in
+            // x and in y.
             let brute = dist
                 .tris
                 .iter()
                 .map(|t| t.corners())
                 .filter(|c| {
-                    let flat = c.map(|x| Point3::new(x.x, x.y, 0.0));
-                    segment_triangle_distance(
-                        &Point3::new(a[0], a[1], 0.0),
-                        &Point3::new(b[0], b[1], 0.0),
-                        &flat,
-                    ) <= rho
+                    (0..2).all(|k| {
+                        let (l, h) = (
+                            c[0][k].min(c[1][k]).min(c[2][k]),
+                            c[0][k].max(c[1][k]).max(c[2][k]),
+                        );
+                        l <= a[k].max(b[k]) + rho && h >= a[k].min(b[k]) - rho
+                    })
                 })
                 .map(|c| c[0].z.max(c[1].z).max(c[2].z))
                 .fold(None, |acc: Option<f64>, z| {
                     Some(acc.map_or(z, |x| x.max(z)))
                 });
             assert_eq!(got, brute);
-            // No surface point within `rho` of the move in plan view lies above it (with
-            // the tessellation's tolerance), and one near it comes close to it.
-            let near: Vec<&Point3> = below.iter().filter(|x| plan_dist(a, b, x) <= rho).collect();
+            // No surface point in the rectangle lies above it, within the tessellation's
+            // tolerance (a point that far inside the rectangle lies on a triangle that meets it).
+            let tol = dist.tolerance_mm;
+            let near: Vec<&Point3> = below
+                .iter()
+                .filter(|x| inside(a, b, rho - tol, x))
+                .collect();
             match got {
                 Some(top) => {
                     met += 1;
                     for x in &near {
-                        assert!(x.z <= top + dist.tolerance_mm, "{} over {top}", x.z);
+                        assert!(x.z <= top + tol, "{} over {top}", x.z);
                     }
                 }
                 None => {

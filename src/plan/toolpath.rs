@@ -14,9 +14,11 @@ pub enum MoveKind {
     Feed = 0,
     /// Staying on the surface between two cuts (step-over, patch transit) at cutting feed.
     Link = 1,
-    /// Leaving the surface along the tool axis to the safe plane.
+    /// Leaving the surface (straight up, or backing out first) towards the safe plane, or
+    /// only as high as the clearance over what the rapid to the next cut passes above.
     Retract = 2,
-    /// Rapid move above the model, or down to the feed height above the next cut.
+    /// Rapid move in the air (at least the clearance over the model), or down to the feed
+    /// height above the next cut.
     Rapid = 3,
     /// Feed move from the approach point onto the surface, at the plunge feed.
     Plunge = 4,
