@@ -149,29 +149,76 @@ fn rapids_turn_the_rotaries_only_at_the_top_of_z() {
                 .find(|w| w.starts_with(c))
                 .map(|w| w[1..].to_string())
         };
+        // Joint output turns at the top of Z (after G53); tool-tip output, whose
+        // tool-centre-point mode stays on, at the program's highest Z (the safe plane).
+        let joints = dialect == "linuxcnc";
+        // The highest Z before the final retract (the moves after the last cut).
+        let lines: Vec<&str> = program.lines().collect();
+        let motion = |l: &&&str| l.split_whitespace().any(|w| w == "G0" || w == "G1");
+        let last_cut = lines
+            .iter()
+            .rposition(|l| l.split_whitespace().any(|w| w == "G1"))
+            .unwrap();
+        let top = lines[..last_cut]
+            .iter()
+            .filter(motion)
+            .filter_map(|l| word(l, 'Z').map(|z| z.parse::<f64>().unwrap()))
+            .fold(f64::MIN, f64::max);
         let (mut rot, mut at_top, mut turned_at_top) = ((None, None), false, 0);
+        let mut z: Option<f64> = None;
+        // After a turn: the level move to above the target, then the way down onto it.
+        let (mut after_turn, mut level_xy) = (0, (None, None));
         for line in program.lines() {
             if line.starts_with("G53") {
                 at_top = true;
                 continue;
             }
-            let (a, c) = (word(line, 'A'), word(line, 'C'));
-            if a.is_none() && c.is_none() {
+            let has = |g: &str| line.split_whitespace().any(|w| w == g);
+            let rapid = has("G0");
+            if !(rapid || has("G1")) {
                 continue;
             }
-            let moves_xyz = ['X', 'Y', 'Z'].iter().any(|&k| word(line, k).is_some());
-            let turns = rot != (a.clone(), c.clone()) && rot != (None, None);
-            if line.starts_with("G0") && turns {
+            let (a, c) = (word(line, 'A'), word(line, 'C'));
+            let (x, y) = (word(line, 'X'), word(line, 'Y'));
+            let new_z = word(line, 'Z').map(|v| v.parse::<f64>().unwrap());
+            let moves_xyz = x.is_some() || y.is_some() || new_z.is_some();
+            let turns = (a.is_some() || c.is_some())
+                && rot != (a.clone(), c.clone())
+                && rot != (None, None);
+            if rapid && turns {
+                let high = if joints {
+                    at_top
+                } else {
+                    z.is_some_and(|z| (z - top).abs() < 1e-9)
+                };
                 assert!(
-                    at_top && !moves_xyz,
-                    "a rapid turns the rotaries away from the top of Z: {line}"
+                    high && !moves_xyz,
+                    "{dialect}: a rapid turns the rotaries away from the top: {line}"
                 );
                 turned_at_top += 1;
+                after_turn = 1;
+            } else if after_turn == 1 {
+                assert!(
+                    rapid && new_z.is_none_or(|v| Some(v) == z),
+                    "{dialect}: after a turn the tool moves level: {line}"
+                );
+                (after_turn, level_xy) = (2, (x.clone(), y.clone()));
+            } else if after_turn == 2 {
+                assert!(
+                    (x.clone(), y.clone()) == level_xy || (x.is_none() && y.is_none()),
+                    "{dialect}: after a turn the tool comes straight down: {line} after {level_xy:?}"
+                );
+                after_turn = 0;
             }
             if moves_xyz {
                 at_top = false;
             }
-            rot = (a, c);
+            if new_z.is_some() {
+                z = new_z;
+            }
+            if a.is_some() || c.is_some() {
+                rot = (a, c);
+            }
         }
         println!(
             "gearbox2-9.tsm, table-table-ac, {dialect}: the rotaries turn {turned_at_top} times at the top of Z"

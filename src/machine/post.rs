@@ -477,6 +477,8 @@ pub fn post_program(
         (true, _) => OutputMode::ToolTip,
     };
     let tips = joints::tips(path);
+    // The safe plane in tool-tip output: the highest tip of the path (mm).
+    let highest_tip = tips.iter().map(|t| t.z).fold(f64::NEG_INFINITY, f64::max);
     for (i, m) in path.moves.iter().enumerate() {
         let ok = m.cl_point.iter().all(|x| x.is_finite())
             && m.tool_axis.iter().all(|x| x.is_finite())
@@ -800,20 +802,34 @@ pub fn post_program(
         // A rapid that turns the rotaries would sweep the tip along a curve (in joint
         // output, and in tool-tip output on a control that does not keep the tip on the
         // line at the rapid rate), and on a table machine swing the part up towards the
-        // tool, which may now stand only the clearance over the part (rapids between cuts
-        // run no higher): turn them at the top of Z first, as at the start of the program.
+        // tool, which between cuts stands only the clearance over what lies beneath it:
+        // go up first (joint output: to the top of Z, as at the start of the program;
+        // tool-tip output, where the control's tool-centre-point mode stays on: to the
+        // path's highest tip, the safe plane), turn the rotaries there, move level to above
+        // the target and come down onto it.
         if rapid && rot_moves && last_tip.is_some() {
-            o.motion(&safe_top());
-            o.motion(&Motion {
+            let safe = |xyz: [Option<f64>; 3], rotary: Vec<(char, f64)>| Motion {
                 rapid: true,
                 machine_frame: false,
-                xyz: [None; 3],
-                rotary: motion.rotary.clone(),
+                xyz,
+                rotary,
                 feed_mode: None,
                 feed: None,
                 extra: "",
                 source: Source::Safe,
-            });
+            };
+            let top = match mode {
+                OutputMode::Joints => {
+                    o.motion(&safe_top());
+                    None
+                }
+                _ => {
+                    o.motion(&safe([None, None, Some(highest_tip)], Vec::new()));
+                    Some(highest_tip)
+                }
+            };
+            o.motion(&safe([None; 3], motion.rotary.clone()));
+            o.motion(&safe([Some(xyz[0]), Some(xyz[1]), top], Vec::new()));
         }
         o.motion(&motion);
         last_rot_text = rot_text;
