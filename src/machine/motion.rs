@@ -21,7 +21,8 @@
 //!   previous one and brake to the next (backward and forward passes over the whole path).
 //!
 //! Times cover the path's moves, from its first point to its last (the program's safe
-//! start and end blocks are not part of the path).
+//! start and end blocks are not part of the path, nor the way up and round that the post
+//! gives a rapid turning the rotaries: such a rapid is timed as the one move it plans).
 //!
 //! Owns: the dynamics fields of a machine and the time model. Must not: change the path or
 //! choose joint values (that is [`super::joints`]).

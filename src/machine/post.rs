@@ -20,6 +20,9 @@
 //! the rotaries turn to the first orientation up there, then the path starts. Safe end: a
 //! retract along the tool axis to the clearance height (the highest cutting point along that
 //! axis plus `clearance_mm`) unless the path already ends there, then the safe Z again.
+//! Between cuts, a rapid that turns the rotaries goes up first (joint output: to the safe Z;
+//! tool-tip output, with the control's tool-centre-point mode on: to the path's highest
+//! tip), turns them there, moves level to above its target and comes down.
 
 use super::joints;
 use super::kinematics::{Joints, Kinematics, Machine};
@@ -209,7 +212,8 @@ pub enum Source {
     /// A point on the chord from path move `i − 1` to move `i`, inserted so the machine's
     /// joint interpolation stays within the chordal tolerance of it.
     Inserted(usize),
-    /// The safe start or end.
+    /// The safe start or end, or the way up, round and down of a rapid that turns the
+    /// rotaries between cuts.
     Safe,
 }
 

@@ -30,7 +30,8 @@ pub struct RoundTrip {
     pub units: String,
     /// Path moves compared (every move of the path).
     pub moves_compared: usize,
-    /// Blocks the post added for the safe start and end.
+    /// Blocks the post added for the safe start and end, and round rapids that turn the
+    /// rotaries.
     pub safe_blocks: usize,
     /// Blocks the post inserted on planned chords (joint-value output). Their ball centre is
     /// compared with the planned chord, their rotaries with the joint-space segment between
