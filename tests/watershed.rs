@@ -145,6 +145,20 @@ fn no_rectangle_is_a_thin_strip_beside_a_feature_box() {
     }
 }
 
+/// Bike.tsm and its watershed and multi-rectangle plans at r 0.5, h 0.01 mm (the page's
+/// tool and scallop).
+fn bike_plans() -> (Model, Vec<(Strategy, PlanOptions, plan::Planned)>) {
+    let m = public_tsm("Bike.tsm");
+    let plans = [Strategy::Watershed, Strategy::MultiRectangle]
+        .map(|strategy| {
+            let o = opts(strategy).with_tool_radius(0.5).with_scallop(0.01);
+            let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
+            (strategy, o, planned)
+        })
+        .into();
+    (m, plans)
+}
+
 /// Bike.tsm's domain is slit from one side to a third of the way: merged largest first,
 /// its rest came in two full-height halves and a sliver below the slit, cut in 2 passes,
 /// and the plan was 16 % longer (3 741 against 3 220 mm at r 0.5, h 0.01 mm). The merge
@@ -152,10 +166,8 @@ fn no_rectangle_is_a_thin_strip_beside_a_feature_box() {
 /// ball.
 #[test]
 fn a_slit_domain_is_cut_without_a_sliver() {
-    let m = public_tsm("Bike.tsm");
-    for strategy in [Strategy::Watershed, Strategy::MultiRectangle] {
-        let o = opts(strategy).with_tool_radius(0.5).with_scallop(0.01);
-        let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
+    let (m, plans) = bike_plans();
+    for (strategy, o, planned) in plans {
         let cut = m.with_layout(planned.layout.clone().unwrap());
         for view in isoparametric::patch_views(&cut) {
             let [a, b] = sides_mm(&view);
@@ -755,10 +767,8 @@ fn moves_leaving_or_crossing_a_crease_do_not_cut_it() {
 /// and gouges are within the request and the tolerance.
 #[test]
 fn a_sliver_rectangle_is_sampled_across_and_the_plan_is_proven() {
-    let m = public_tsm("Bike.tsm");
-    for strategy in [Strategy::Watershed, Strategy::MultiRectangle] {
-        let o = opts(strategy).with_tool_radius(0.5).with_scallop(0.01);
-        let planned = plan::plan(&m, &o, &mut |_| true).unwrap();
+    let (m, plans) = bike_plans();
+    for (strategy, o, planned) in plans {
         let v = simulated(&m, &planned, &o);
         println!(
             "Bike.tsm {strategy:?} r 0.5 h 0.01: {} samples, error bound {:.5} mm (target \

@@ -12,10 +12,10 @@
 //! clear), until it is outside the model's box grown by the ball and the clearance; from
 //! there it rises beside the model. Approaches mirror retracts.
 
-use super::distance::SurfaceDistance;
+use super::distance::{PlanRect, SurfaceDistance};
 use super::toolpath::{Move, MoveKind, Toolpath};
 use super::PlanOptions;
-use crate::geom::{least, most, Point3, Vector3};
+use crate::geom::{most, Point3, Vector3};
 use crate::model::Model;
 
 /// What routing the air moves found.
@@ -296,9 +296,7 @@ const AXIS_VERTICAL: f64 = 1e-12;
 impl<'a> Beneath<'a> {
     fn new(model: &Model, opts: &PlanOptions, dist: &'a SurfaceDistance, r: f64) -> Self {
         let (bbox, stock) = (model.surface.bbox(), model.stock);
-        let size = (0..3)
-            .map(|k| bbox.max[k] - bbox.min[k])
-            .fold(0.0, f64::max);
+        let size = bbox.size().into_iter().fold(0.0, f64::max);
         let beyond = (0..3).any(|k| {
             stock.min[k] < bbox.min[k] - STOCK_SAME_SHARE * size
                 || stock.max[k] > bbox.max[k] + STOCK_SAME_SHARE * size
@@ -326,19 +324,13 @@ impl<'a> Beneath<'a> {
         self.parts
             .iter()
             .filter_map(|&(rho, lowest)| {
-                let reach = rho + c + tol;
-                let surface = self.dist.highest_under(a, b, reach).map(|z| z + tol);
-                let stock = self.stock.and_then(|s| {
-                    let near = (0..2).all(|k| {
-                        least(a[k], b[k]) - reach <= s.max[k]
-                            && most(a[k], b[k]) + reach >= s.min[k]
-                    });
-                    near.then_some(s.max[2])
-                });
-                let top = match (surface, stock) {
-                    (Some(x), Some(y)) => Some(most(x, y)),
-                    (x, y) => x.or(y),
-                }?;
+                let rect = PlanRect::spanned(a, b, rho + c + tol);
+                let surface = self.dist.highest_under(&rect).map(|z| z + tol);
+                let stock = self
+                    .stock
+                    .filter(|s| rect.meets([s.min[0], s.min[1]], [s.max[0], s.max[1]]))
+                    .map(|s| s.max[2]);
+                let top = [surface, stock].into_iter().flatten().reduce(most)?;
                 Some(top + c - lowest)
             })
             .reduce(most)

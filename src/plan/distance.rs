@@ -255,24 +255,17 @@ impl SurfaceDistance {
     }
 
     /// The highest corner (z, mm) of the triangles whose plan view (their box projected on
-    /// XY) meets the rectangle spanned by `a` and `b` grown by `rho` on every side (mm), or
-    /// `None` where none does: what a vertical tool `rho` wide may pass over on a rapid from
-    /// above `a` to above `b`, on a control that moves each axis at its own rate (the tool
-    /// then keeps within that rectangle, not on the line). Callers add
+    /// XY) meets `rect`, or `None` where none does: what a vertical tool may pass over on a
+    /// rapid whose plan view keeps within `rect` ([`PlanRect::spanned`]). Callers add
     /// [`Self::tolerance_mm`].
-    pub fn highest_under(&self, a: [f64; 2], b: [f64; 2], rho: f64) -> Option<f64> {
+    pub fn highest_under(&self, rect: &PlanRect) -> Option<f64> {
         let best = std::cell::Cell::new(f64::NEG_INFINITY);
-        let lo = [least(a[0], b[0]) - rho, least(a[1], b[1]) - rho];
-        let hi = [most(a[0], b[0]) + rho, most(a[1], b[1]) + rho];
-        let meets = |l: [f64; 2], h: [f64; 2]| {
-            l[0] <= hi[0] && h[0] >= lo[0] && l[1] <= hi[1] && h[1] >= lo[1]
-        };
         self.leaves_meeting(
             |n: &Wide| {
                 // Children whose plan view meets the rectangle and that reach above the
                 // highest corner found so far.
                 std::array::from_fn(|j| {
-                    meets([n.lo[0][j], n.lo[1][j]], [n.hi[0][j], n.hi[1][j]])
+                    rect.meets([n.lo[0][j], n.lo[1][j]], [n.hi[0][j], n.hi[1][j]])
                         && n.hi[2][j] > best.get()
                 })
             },
@@ -283,7 +276,7 @@ impl SurfaceDistance {
                     [0, 1].map(|k| most(most(c[0][k], c[1][k]), c[2][k])),
                 );
                 let top = most(most(c[0].z, c[1].z), c[2].z);
-                if top > best.get() && meets(l, h) {
+                if top > best.get() && rect.meets(l, h) {
                     best.set(top);
                 }
                 None::<()>
@@ -348,6 +341,30 @@ impl SurfaceDistance {
             }
         }
         None
+    }
+}
+
+/// A rectangle in plan view (XY, mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanRect {
+    pub lo: [f64; 2],
+    pub hi: [f64; 2],
+}
+
+impl PlanRect {
+    /// The rectangle spanned by `a` and `b` grown by `grow` on every side (mm): where a
+    /// vertical tool `grow` wide may pass on a rapid from above `a` to above `b`, on a control
+    /// that moves each axis at its own rate (the tool then keeps within it, not on the line).
+    pub fn spanned(a: [f64; 2], b: [f64; 2], grow: f64) -> Self {
+        PlanRect {
+            lo: [0, 1].map(|k| least(a[k], b[k]) - grow),
+            hi: [0, 1].map(|k| most(a[k], b[k]) + grow),
+        }
+    }
+
+    /// Whether the box from `lo` to `hi` (plan view) meets the rectangle (touching counts).
+    pub fn meets(&self, lo: [f64; 2], hi: [f64; 2]) -> bool {
+        (0..2).all(|k| lo[k] <= self.hi[k] && hi[k] >= self.lo[k])
     }
 }
 
@@ -974,10 +991,6 @@ mod tests {
                 })
             })
             .collect();
-        // Whether `q` lies in the rectangle spanned by `a` and `b` grown by `rho`.
-        let inside = |a: [f64; 2], b: [f64; 2], rho: f64, q: &Point3| {
-            (0..2).all(|k| q[k] >= a[k].min(b[k]) - rho && q[k] <= a[k].max(b[k]) + rho)
-        };
         let mut rnd = crate::testing::uniform(777u64);
         let (mut met, mut missed) = (0, 0);
         for k in 0..60 {
@@ -990,22 +1003,19 @@ mod tests {
             };
             let (a, b) = ([p.x + aside, p.y], [q.x + aside, q.y]);
             let rho = if k % 2 == 0 { 0.3 * rnd() } else { 3.0 * rnd() };
-            let got = dist.highest_under(a, b, rho);
+            let rect = PlanRect::spanned(a, b, rho);
+            let got = dist.highest_under(&rect);
             // The hierarchy prunes nothing it should not: every triangle tested finds the same.
-            // A triangle's plan-view box meets the rectangle where the two ranges overlap in
-            // x and in y.
             let brute = dist
                 .tris
                 .iter()
                 .map(|t| t.corners())
                 .filter(|c| {
-                    (0..2).all(|k| {
-                        let (l, h) = (
-                            c[0][k].min(c[1][k]).min(c[2][k]),
-                            c[0][k].max(c[1][k]).max(c[2][k]),
-                        );
-                        l <= a[k].max(b[k]) + rho && h >= a[k].min(b[k]) - rho
-                    })
+                    let (l, h) = (
+                        [0, 1].map(|k| c[0][k].min(c[1][k]).min(c[2][k])),
+                        [0, 1].map(|k| c[0][k].max(c[1][k]).max(c[2][k])),
+                    );
+                    rect.meets(l, h)
                 })
                 .map(|c| c[0].z.max(c[1].z).max(c[2].z))
                 .fold(None, |acc: Option<f64>, z| {
@@ -1015,9 +1025,10 @@ mod tests {
             // No surface point in the rectangle lies above it, within the tessellation's
             // tolerance (a point that far inside the rectangle lies on a triangle that meets it).
             let tol = dist.tolerance_mm;
+            let inner = PlanRect::spanned(a, b, rho - tol);
             let near: Vec<&Point3> = below
                 .iter()
-                .filter(|x| inside(a, b, rho - tol, x))
+                .filter(|x| inner.meets([x.x, x.y], [x.x, x.y]))
                 .collect();
             match got {
                 Some(top) => {
